@@ -1,0 +1,62 @@
+/* accel.c — the Embree 3 scene: triangle geometry for quads, boxes and meshes; Embree's analytic
+ * point-spheres for spheres. Geometry ids equal shape indices. */
+#include "scene.h"
+#include "util.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static void embree_error(void *user, enum RTCError code, const char *str)
+{
+    (void)user;
+    murk_log(MURK_LOG_WARN, "embree error %d: %s", (int)code, str ? str : "");
+}
+
+int murk_accel_build(murk_scene *s, char *err, size_t errlen)
+{
+    s->device = rtcNewDevice(NULL);
+    if (!s->device) {
+        snprintf(err, errlen, "%s: cannot create an Embree device (error %d)", s->doc.file, (int)rtcGetDeviceError(NULL));
+        return -1;
+    }
+    rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    s->rtc = rtcNewScene(s->device);
+    rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
+    for (size_t i = 0; i < s->nshapes; i++) {
+        murk_shape *sh = &s->shapes[i];
+        RTCGeometry g;
+        if (sh->type == MURK_SHAPE_SPHERE) {
+            g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+            float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1);
+            v[0] = sh->center.x, v[1] = sh->center.y, v[2] = sh->center.z, v[3] = sh->radius;
+        } else {
+            g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            /* Embree reads 16 bytes past the last vertex: shared buffers need that padding. */
+            float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                               sh->nverts);
+            uint32_t *ix = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
+                                                   sh->ntris);
+            if (!v || !ix) {
+                rtcReleaseGeometry(g);
+                snprintf(err, errlen, "%s: Embree could not allocate geometry for shape %zu", s->doc.file, i);
+                return -1;
+            }
+            memcpy(v, sh->pos, 3u * sh->nverts * sizeof(float));
+            memcpy(ix, sh->idx, 3u * sh->ntris * sizeof(uint32_t));
+        }
+        rtcCommitGeometry(g);
+        unsigned id = rtcAttachGeometry(s->rtc, g);
+        rtcReleaseGeometry(g);
+        if (id != i) {
+            snprintf(err, errlen, "%s: internal error: Embree geometry id %u for shape %zu", s->doc.file, id, i);
+            return -1;
+        }
+    }
+    rtcCommitScene(s->rtc);
+    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
+        snprintf(err, errlen, "%s: Embree failed to build the scene", s->doc.file);
+        return -1;
+    }
+    return 0;
+}

@@ -1,0 +1,419 @@
+/* cli.c — the murk command line:
+ *   murk render SCENE.yaml [-o out.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S]
+ *   murk plugins [NAME]
+ *   murk compare A.exr B.exr [--diff d.png]
+ * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
+#include "host.h"
+#include "image.h"
+#include "plugin_loader.h"
+#include "scene.h"
+#include "util.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char usage_text[] =
+    "usage:\n"
+    "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
+    "  murk plugins [NAME]\n"
+    "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+    "  murk --version\n";
+
+static int usage(const char *msg)
+{
+    if (msg)
+        fprintf(stderr, "murk: %s\n", msg);
+    fputs(usage_text, stderr);
+    return 2;
+}
+
+static int parse_int_arg(const char *opt, const char *v, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long x = v ? strtol(v, &end, 10) : 0;
+    if (!v || !*v || *end || errno || x < lo || x > hi) {
+        fprintf(stderr, "murk: %s needs a whole number in [%ld, %ld], got '%s'\n", opt, lo, hi, v ? v : "");
+        return -1;
+    }
+    *out = x;
+    return 0;
+}
+
+static char *default_output(const char *scene)
+{
+    const char *base = strrchr(scene, '/');
+    base = base ? base + 1 : scene;
+    size_t n = strlen(base);
+    if (n > 5 && strcmp(base + n - 5, ".yaml") == 0)
+        n -= 5;
+    else if (n > 4 && strcmp(base + n - 4, ".yml") == 0)
+        n -= 4;
+    char *out = murk_xmalloc(n + 5);
+    memcpy(out, base, n);
+    memcpy(out + n, ".exr", 5);
+    return out;
+}
+
+static char *png_path_for(const char *exr)
+{
+    size_t n = strlen(exr) - 4;
+    char *p = murk_xmalloc(n + 5);
+    memcpy(p, exr, n);
+    memcpy(p + n, ".png", 5);
+    return p;
+}
+
+static void human(double v, char *buf, size_t n)
+{
+    if (v >= 1e9)
+        snprintf(buf, n, "%.2f G", v / 1e9);
+    else if (v >= 1e6)
+        snprintf(buf, n, "%.2f M", v / 1e6);
+    else if (v >= 1e3)
+        snprintf(buf, n, "%.2f k", v / 1e3);
+    else
+        snprintf(buf, n, "%.0f ", v);
+}
+
+static int cmd_render(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL;
+    const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
+    size_t nsets = 0;
+    murk_render_opts opts = {0};
+    int quiet = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        long x;
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (!v)
+                return free(sets), usage("-o needs a file name");
+            out = v, i++;
+        } else if (!strcmp(a, "--spp")) {
+            if (parse_int_arg(a, v, 1, 1 << 24, &x))
+                return free(sets), 2;
+            opts.spp = (int)x, i++;
+        } else if (!strcmp(a, "--threads")) {
+            if (parse_int_arg(a, v, 1, 1024, &x))
+                return free(sets), 2;
+            opts.threads = (int)x, i++;
+        } else if (!strcmp(a, "--time")) {
+            char *end;
+            double t = v ? strtod(v, &end) : 0;
+            if (!v || *end || !(t > 0) || !isfinite(t)) {
+                fprintf(stderr, "murk: --time needs a positive number of seconds, got '%s'\n", v ? v : "");
+                return free(sets), 2;
+            }
+            opts.time_limit = t, i++;
+        } else if (!strcmp(a, "--set")) {
+            if (!v)
+                return free(sets), usage("--set needs KEY.PATH=VALUE");
+            sets[nsets++] = v, i++;
+        } else if (!strncmp(a, "--set=", 6)) {
+            sets[nsets++] = a + 6;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "murk: unknown option '%s'\n", a);
+            return free(sets), usage(NULL);
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n", scene_path, a);
+            return free(sets), 2;
+        }
+    }
+    if (!scene_path)
+        return free(sets), usage("render needs a scene file");
+    char *outbuf = out ? murk_strdup(out) : default_output(scene_path);
+    size_t ol = strlen(outbuf);
+    if (ol < 5 || strcmp(outbuf + ol - 4, ".exr") != 0) {
+        fprintf(stderr, "murk: the output file must end in .exr, got '%s'\n", outbuf);
+        free(outbuf);
+        free(sets);
+        return 2;
+    }
+    murk_set_quiet(quiet);
+    char err[2048];
+    murk_scene *s = murk_scene_load(scene_path, sets, nsets, err, sizeof err);
+    if (!s) {
+        fprintf(stderr, "%s\n", err);
+        free(outbuf);
+        free(sets);
+        return 1;
+    }
+    opts.progress = !quiet && isatty(STDERR_FILENO);
+    murk_render_result res;
+    murk_render(s, &opts, &res);
+
+    char spp[32], seed[32], secs[32], nonfinite[32], setbuf[4096] = "";
+    snprintf(spp, sizeof spp, "%d", res.spp);
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
+    snprintf(secs, sizeof secs, "%.3f", res.seconds);
+    snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
+    for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
+        k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
+    murk_kv meta[] = {
+        {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
+        {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
+        {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf},
+    };
+    char *png = png_path_for(outbuf);
+    int rc = 0;
+    if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, (int)(sizeof meta / sizeof meta[0]), err,
+                       sizeof err) != 0 ||
+        murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0) {
+        fprintf(stderr, "murk: %s\n", err);
+        rc = 1;
+    }
+    if (rc == 0 && !quiet) {
+        char sps[32], rps[32];
+        human((double)res.samples / res.seconds, sps, sizeof sps);
+        human((double)res.rays / res.seconds, rps, sizeof rps);
+        printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
+               res.seconds, sps, rps);
+    }
+    if (res.nonfinite)
+        murk_log(MURK_LOG_WARN, "%llu samples were NaN or infinite and were left out of their pixels",
+                 (unsigned long long)res.nonfinite);
+    free(png);
+    free(res.rgb);
+    murk_scene_free(s);
+    free(outbuf);
+    free(sets);
+    return rc;
+}
+
+/* ---- plugins ------------------------------------------------------------------------------- */
+
+static const char *type_name(uint32_t t)
+{
+    static const char *const names[] = {"?", "float", "int", "bool", "rgb", "string", "enum"};
+    return t <= MURK_PARAM_ENUM ? names[t] : "?";
+}
+
+static void describe(const murk_plugin *p)
+{
+    const murk_plugin_desc *d = p->desc;
+    printf("%s %s — %s\n  file: %s (ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path,
+           p->abi.major, p->abi.minor);
+    if (d->kind == MURK_KIND_MEDIUM)
+        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor\n");
+    if (!d->nparams) {
+        printf("  no parameters\n");
+        return;
+    }
+    printf("  parameters:\n");
+    for (uint32_t i = 0; i < d->nparams; i++) {
+        const murk_param *q = &d->params[i];
+        char def[128], range[96] = "";
+        switch (q->type) {
+        case MURK_PARAM_RGB:
+            snprintf(def, sizeof def, "[%g, %g, %g]", q->def[0], q->def[1], q->def[2]);
+            break;
+        case MURK_PARAM_BOOL:
+            snprintf(def, sizeof def, "%s", q->def[0] != 0 ? "true" : "false");
+            break;
+        case MURK_PARAM_STRING:
+        case MURK_PARAM_ENUM:
+            snprintf(def, sizeof def, "%s", q->def_str ? q->def_str : "");
+            break;
+        default:
+            snprintf(def, sizeof def, "%g", q->def[0]);
+        }
+        if (q->type == MURK_PARAM_ENUM)
+            snprintf(range, sizeof range, "one of %s", q->choices);
+        else if (q->type != MURK_PARAM_STRING && q->type != MURK_PARAM_BOOL)
+            snprintf(range, sizeof range, "[%g, %g]", q->min, q->max);
+        printf("    %-16s %-6s default %-18s %-22s %s%s%s\n", q->name, type_name(q->type), def, range, q->doc,
+               (q->flags & MURK_PARAM_TEXTURABLE) ? " (texturable)" : "", (q->flags & MURK_PARAM_REQUIRED) ? " (required)" : "");
+    }
+}
+
+static int cmd_plugins(int argc, char **argv)
+{
+    murk_registry reg;
+    murk_registry_init(&reg);
+    char err[1024];
+    int rc = 0;
+    if (argc > 1) {
+        murk_registry_free(&reg);
+        return usage("plugins takes at most one name");
+    }
+    if (argc == 1) {
+        const murk_plugin *p = murk_registry_load(&reg, 0, argv[0], err, sizeof err);
+        if (p)
+            describe(p);
+        else {
+            fprintf(stderr, "murk: %s\n", err);
+            rc = 1;
+        }
+        murk_registry_free(&reg);
+        return rc;
+    }
+    for (size_t i = 0; i < reg.ndirs; i++) {
+        DIR *d = opendir(reg.dirs[i]);
+        if (!d)
+            continue;
+        struct dirent *e;
+        char **names = NULL;
+        size_t nn = 0;
+        while ((e = readdir(d))) {
+            size_t l = strlen(e->d_name);
+            if (l > 3 && strcmp(e->d_name + l - 3, ".so") == 0) {
+                names = murk_xrealloc(names, (nn + 1) * sizeof *names);
+                names[nn++] = murk_strdup(e->d_name);
+            }
+        }
+        closedir(d);
+        for (size_t a = 0; a < nn; a++) /* sorted listing */
+            for (size_t b = a + 1; b < nn; b++)
+                if (strcmp(names[b], names[a]) < 0) {
+                    char *t = names[a];
+                    names[a] = names[b];
+                    names[b] = t;
+                }
+        for (size_t k = 0; k < nn; k++) {
+            size_t n = strlen(reg.dirs[i]) + strlen(names[k]) + 2;
+            char *path = murk_xmalloc(n);
+            snprintf(path, n, "%s/%s", reg.dirs[i], names[k]);
+            murk_plugin p;
+            if (murk_plugin_open(path, 0, &p, err, sizeof err) == 0) {
+                printf("%-10s %-16s %-58s %s\n", murk_kind_name((int)p.desc->kind), p.desc->name, p.desc->description,
+                       path);
+                murk_plugin_close(&p);
+            } else {
+                printf("%-10s %-16s %s\n", "(broken)", names[k], err);
+            }
+            free(path);
+            free(names[k]);
+        }
+        free(names);
+    }
+    murk_registry_free(&reg);
+    return rc;
+}
+
+/* ---- compare ------------------------------------------------------------------------------- */
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+static int cmd_compare(int argc, char **argv)
+{
+    const char *a = NULL, *b = NULL, *diff = NULL;
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--diff")) {
+            if (i + 1 >= argc)
+                return usage("--diff needs a .png file name");
+            diff = argv[++i];
+        } else if (!a) {
+            a = argv[i];
+        } else if (!b) {
+            b = argv[i];
+        } else {
+            return usage("compare takes two images");
+        }
+    }
+    if (!a || !b)
+        return usage("compare needs two EXR files: TEST REFERENCE");
+    murk_image A = {0}, B = {0};
+    char err[1024];
+    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
+        fprintf(stderr, "murk: %s\n", err);
+        murk_image_free(&A);
+        return 1;
+    }
+    int rc = 0;
+    if (A.w != B.w || A.h != B.h) {
+        fprintf(stderr, "murk: %s is %dx%d but %s is %dx%d\n", a, A.w, A.h, b, B.w, B.h);
+        rc = 1;
+    } else {
+        size_t n = (size_t)A.w * (size_t)A.h;
+        double mse = 0, rel = 0, mar = 0;
+        size_t bad = 0;
+        float *d = murk_xmalloc(n * sizeof(float));
+        for (size_t i = 0; i < n; i++) {
+            double dp = 0;
+            for (int c = 0; c < 3; c++) {
+                double x = A.rgb[3 * i + (size_t)c], r = B.rgb[3 * i + (size_t)c];
+                if (!isfinite(x) || !isfinite(r)) {
+                    bad++;
+                    continue;
+                }
+                double e = x - r;
+                mse += e * e;
+                rel += e * e / (r * r + 1e-2);
+                mar += fabs(e) / (fabs(r) + 1e-2);
+                dp += fabs(e);
+            }
+            d[i] = (float)(dp / 3);
+        }
+        double m = 3.0 * (double)n;
+        printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
+               mse / m, rel / m, mar / m, a, b);
+        if (bad)
+            printf("warning: %zu non-finite values skipped\n", bad);
+        if (diff) {
+            float *sorted = murk_xmalloc(n * sizeof(float));
+            memcpy(sorted, d, n * sizeof(float));
+            qsort(sorted, n, sizeof(float), cmp_float);
+            float p99 = sorted[(size_t)(0.99 * (double)(n - 1))];
+            float scale = p99 > 0 ? 1.0f / p99 : 1.0f;
+            free(sorted);
+            float *rgb = murk_xmalloc(3 * n * sizeof(float));
+            for (size_t i = 0; i < n; i++) { /* black -> red -> yellow -> white heat map */
+                float t = fminf(1.0f, d[i] * scale);
+                rgb[3 * i] = fminf(1.0f, 3 * t);
+                rgb[3 * i + 1] = fminf(1.0f, fmaxf(0.0f, 3 * t - 1));
+                rgb[3 * i + 2] = fmaxf(0.0f, 3 * t - 2);
+                for (int c = 0; c < 3; c++) /* the PNG writer applies the sRGB curve: undo it */
+                    rgb[3 * i + (size_t)c] = powf(rgb[3 * i + (size_t)c], 2.2f);
+            }
+            if (murk_png_write(diff, rgb, A.w, A.h, 0.0f, err, sizeof err)) {
+                fprintf(stderr, "murk: %s\n", err);
+                rc = 1;
+            } else {
+                printf("diff image %s: |a-b| averaged over channels, white = 99th percentile (%.3e)\n", diff, p99);
+            }
+            free(rgb);
+        }
+        free(d);
+    }
+    murk_image_free(&A);
+    murk_image_free(&B);
+    return rc;
+}
+
+MURK_API int murk_cli_main(int argc, char **argv)
+{
+    if (argc < 2)
+        return usage(NULL);
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "render"))
+        return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "plugins"))
+        return cmd_plugins(argc - 2, argv + 2);
+    if (!strcmp(cmd, "compare"))
+        return cmd_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "--version")) {
+        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        return 0;
+    }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        fputs(usage_text, stdout);
+        return 0;
+    }
+    fprintf(stderr, "murk: unknown command '%s'\n", cmd);
+    return usage(NULL);
+}

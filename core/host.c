@@ -1,0 +1,232 @@
+/* host.c — the services table plugins receive: memory, logging, textures, and the scene queries
+ * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays are counted
+ * per thread for the rays/s figure. */
+#include "host.h"
+#include "scene.h"
+#include "texture.h"
+#include "util.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static _Thread_local uint64_t thread_rays;
+
+uint64_t murk_host_thread_rays(void) { return thread_rays; }
+void murk_host_thread_reset(void) { thread_rays = 0; }
+
+static void *host_alloc(size_t n) { return calloc(1, n ? n : 1); }
+static void host_free(void *p) { free(p); }
+
+static void host_log(int level, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    murk_log(level, "%s", buf);
+}
+
+static void host_tex_eval(const murk_texture *t, const murk_hit *hit, float out[3]) { murk_texture_eval(t, hit, out); }
+
+static murk_vec3 vtx(const murk_shape *sh, uint32_t i)
+{
+    return murk_v3(sh->pos[3 * i], sh->pos[3 * i + 1], sh->pos[3 * i + 2]);
+}
+
+static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRayHit *rh, murk_hit *h)
+{
+    const murk_shape *sh = &s->shapes[rh->hit.geomID];
+    h->t = rh->ray.tfar;
+    h->geom = rh->hit.geomID;
+    h->prim = rh->hit.primID;
+    if (sh->type == MURK_SHAPE_SPHERE) {
+        murk_vec3 p = murk_madd(r->o, r->d, h->t);
+        murk_vec3 n = murk_normalize(murk_sub(p, sh->center));
+        h->p = murk_madd(sh->center, n, sh->radius); /* re-project onto the surface */
+        h->ng = h->n = n;
+        h->u = 0.5f + atan2f(n.z, n.x) * (0.5f * MURK_INV_PI);
+        h->v = acosf(fminf(1.0f, fmaxf(-1.0f, n.y))) * MURK_INV_PI;
+    } else {
+        const uint32_t *ix = &sh->idx[3 * h->prim];
+        float b1 = rh->hit.u, b2 = rh->hit.v, b0 = 1.0f - b1 - b2;
+        murk_vec3 a = vtx(sh, ix[0]), b = vtx(sh, ix[1]), c = vtx(sh, ix[2]);
+        h->p = murk_add(murk_add(murk_mul(a, b0), murk_mul(b, b1)), murk_mul(c, b2));
+        h->ng = murk_normalize(murk_cross(murk_sub(b, a), murk_sub(c, a)));
+        h->n = h->ng;
+        if (sh->nrm) {
+            const float *n0 = &sh->nrm[3 * ix[0]], *n1 = &sh->nrm[3 * ix[1]], *n2 = &sh->nrm[3 * ix[2]];
+            murk_vec3 ns = murk_normalize(murk_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0], b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
+                                                  b0 * n0[2] + b1 * n1[2] + b2 * n2[2]));
+            if (murk_dot(ns, ns) > 0.5f)
+                h->n = murk_dot(ns, h->ng) < 0.0f ? murk_neg(ns) : ns;
+        }
+        if (sh->uv) {
+            const float *t0 = &sh->uv[2 * ix[0]], *t1 = &sh->uv[2 * ix[1]], *t2 = &sh->uv[2 * ix[2]];
+            h->u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
+            h->v = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
+        } else {
+            h->u = b1;
+            h->v = b2;
+        }
+    }
+    h->material = sh->material;
+    h->interior = sh->interior;
+    h->exterior = sh->exterior;
+    h->emission = sh->emission;
+    h->light = sh->light_base < 0 ? -1 : sh->light_base + (sh->type == MURK_SHAPE_SPHERE ? 0 : (int32_t)h->prim);
+}
+
+static void to_embree(const murk_ray *r, struct RTCRay *er)
+{
+    er->org_x = r->o.x, er->org_y = r->o.y, er->org_z = r->o.z;
+    er->dir_x = r->d.x, er->dir_y = r->d.y, er->dir_z = r->d.z;
+    er->tnear = r->tmin;
+    er->tfar = r->tmax;
+    er->time = 0.0f;
+    er->mask = 0xffffffffu;
+    er->id = 0;
+    er->flags = 0;
+}
+
+static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    to_embree(r, &rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(s->rtc, &ctx, &rh);
+    thread_rays++;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    fill_hit(s, r, &rh, h);
+    return 1;
+}
+
+static int host_occluded(const murk_scene *s, const murk_ray *r)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRay er;
+    to_embree(r, &er);
+    rtcOccluded1(s->rtc, &ctx, &er);
+    thread_rays++;
+    return er.tfar < 0.0f;
+}
+
+/* 1 - cos(theta_max) of the cone a sphere subtends from distance d > r, accurate when tiny. */
+static float cone_one_minus_cos(float r, float d)
+{
+    float sin2 = (r * r) / (d * d);
+    float cosm = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+    return sin2 / (1.0f + cosm);
+}
+
+static int host_sample_light(const murk_scene *s, murk_vec3 p, const float u[3], murk_light_sample *ls)
+{
+    memset(ls, 0, sizeof *ls);
+    if (s->nlights == 0 || s->light_power <= 0.0f)
+        return 0;
+    size_t lo = 0, hi = s->nlights; /* find i with cdf[i] <= u0 < cdf[i+1] */
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (s->light_cdf[mid] <= u[0])
+            lo = mid;
+        else
+            hi = mid;
+    }
+    while (lo > 0 && s->lights[lo].pmf <= 0.0f) /* never land on a zero-power light */
+        lo--;
+    const murk_light *l = &s->lights[lo];
+    if (l->pmf <= 0.0f)
+        return 0;
+    if (l->sphere) {
+        murk_vec3 dc = murk_sub(l->center, p);
+        float d = murk_length(dc);
+        if (d <= l->radius * 1.0001f)
+            return 0; /* inside (or on) an outward-emitting sphere: it sends nothing this way */
+        murk_vec3 w = murk_mul(dc, 1.0f / d), t, b;
+        murk_basis(w, &t, &b);
+        float omc = cone_one_minus_cos(l->radius, d);
+        float one_minus_cos = u[1] * omc;
+        float cost = 1.0f - one_minus_cos;
+        float sint = sqrtf(fmaxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+        float phi = 2.0f * MURK_PI * u[2];
+        murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
+        /* distance to the near intersection along dir */
+        float bq = murk_dot(dir, dc);
+        float disc = l->radius * l->radius - (d * d - bq * bq);
+        float dist = bq - sqrtf(fmaxf(0.0f, disc));
+        ls->wi = dir;
+        ls->dist = fmaxf(dist, 0.0f);
+        ls->le = l->le;
+        ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
+        return ls->pdf > 0.0f && isfinite(ls->pdf);
+    }
+    float su = sqrtf(u[1]);
+    murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+    murk_vec3 d = murk_sub(q, p);
+    float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
+    if (dist <= 0.0f)
+        return 0;
+    murk_vec3 wi = murk_mul(d, 1.0f / dist);
+    float cosl = -murk_dot(l->n, wi);
+    if (cosl <= 0.0f)
+        return 0;
+    ls->wi = wi;
+    ls->dist = dist;
+    ls->le = l->le;
+    ls->pdf = l->pmf * dist2 / (cosl * l->area);
+    return isfinite(ls->pdf) && ls->pdf > 0.0f;
+}
+
+static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
+{
+    if (h->light < 0 || (size_t)h->light >= s->nlights)
+        return 0.0f;
+    const murk_light *l = &s->lights[h->light];
+    if (l->sphere) {
+        float d = murk_length(murk_sub(l->center, p));
+        if (d <= l->radius * 1.0001f)
+            return 0.0f;
+        return l->pmf / (2.0f * MURK_PI * cone_one_minus_cos(l->radius, d));
+    }
+    murk_vec3 dv = murk_sub(h->p, p);
+    float dist2 = murk_dot(dv, dv);
+    if (dist2 <= 0.0f)
+        return 0.0f;
+    float cosl = -murk_dot(l->n, dv) / sqrtf(dist2);
+    if (cosl <= 0.0f)
+        return 0.0f;
+    return l->pmf * dist2 / (cosl * l->area);
+}
+
+static murk_rgb host_background(const murk_scene *s, murk_vec3 dir)
+{
+    (void)dir;
+    return s->background;
+}
+
+static const murk_medium *host_camera_medium(const murk_scene *s) { return s->camera_medium; }
+
+static const murk_host host_table = {
+    .size = sizeof(murk_host),
+    .abi_major = MURK_ABI_MAJOR,
+    .abi_minor = MURK_ABI_MINOR,
+    .alloc = host_alloc,
+    .free = host_free,
+    .log = host_log,
+    .tex_eval = host_tex_eval,
+    .intersect = host_intersect,
+    .occluded = host_occluded,
+    .sample_light = host_sample_light,
+    .light_pdf = host_light_pdf,
+    .background = host_background,
+    .camera_medium = host_camera_medium,
+};
+
+const murk_host *murk_host_table(void) { return &host_table; }

@@ -1,0 +1,30 @@
+/* image.h — image files: linear float EXR through OpenEXRCore, 8-bit sRGB PNG through libpng.
+ * Internal to libmurk. Pixels are interleaved RGB floats, row-major, row 0 at the top.
+ * Writers write PATH.tmp-PID and rename it over PATH only when the whole file is written, so a failed
+ * or interrupted run never leaves a half-written image. Every function returns 0 on success, or -1
+ * with a one-line message in err ("path: what is wrong"). */
+#ifndef MURK_IMAGE_H
+#define MURK_IMAGE_H
+
+#include <stddef.h>
+
+typedef struct murk_kv { const char *key, *value; } murk_kv;
+
+typedef struct murk_image {
+    int w, h;
+    float *rgb;       /* 3*w*h floats */
+    int nmeta;        /* string attributes read back from an EXR (key/value pairs, malloc'd) */
+    murk_kv *meta;
+} murk_image;
+
+int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_kv *meta, int nmeta,
+                   char *err, size_t errlen);
+int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen);
+/* Tone map for preview: clamp to [0,1] after multiplying by 2^exposure, sRGB transfer, 8 bits. */
+int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen);
+/* Decodes 8/16-bit grey/RGB/RGBA/palette PNGs; sRGB-encoded values are converted to linear when srgb=1. */
+int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen);
+const char *murk_image_meta(const murk_image *img, const char *key); /* NULL if absent */
+void murk_image_free(murk_image *img);
+
+#endif

@@ -1,0 +1,38 @@
+/* murk/material.h — the material (BSDF) plugin interface.
+ *
+ * Directions are in the local shading frame: the normal is +z. The integrator flips the frame to the
+ * side wo lies on, so wo.z >= 0 on every call and two-sided materials need no special case; wi may lie
+ * below (wi.z < 0) and a reflection-only material returns zero there. eval() returns the BSDF value f
+ * without the cosine; pdf() is the solid-angle density that sample() draws wi from; sample() returns 0
+ * (and pdf 0) when it produces no direction — never an infinite weight. The path weight of a sample is
+ * always f * |wi.z| / pdf; a delta lobe sets f and pdf so that this ratio is its reflectance (e.g. pdf =
+ * the lobe's selection probability, f = F / |wi.z|) and sets `delta` so the integrator skips MIS. */
+#ifndef MURK_MATERIAL_H
+#define MURK_MATERIAL_H
+
+#include "murk/plugin.h"
+
+typedef struct murk_bsdf_sample {
+    murk_vec3 wi;   /* local frame, unit */
+    murk_rgb f;     /* BSDF value for (wo, wi), without cosine */
+    float pdf;      /* solid-angle pdf of wi (for a delta lobe: the discrete probability) */
+    int delta;      /* 1 if wi came from a delta (perfectly specular) lobe: the integrator skips MIS */
+} murk_bsdf_sample;
+
+typedef struct murk_material_vt {
+    uint32_t size; /* sizeof(murk_material_vt) of the plugin */
+    murk_create_fn create;
+    void (*destroy)(void *self);
+    murk_rgb (*eval)(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi);
+    float (*pdf)(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi);
+    int (*sample)(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s);
+} murk_material_vt;
+
+/* A material as the scene holds it. */
+struct murk_material {
+    const murk_material_vt *vt;
+    void *self;
+    const char *name;
+};
+
+#endif

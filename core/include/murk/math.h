@@ -1,0 +1,101 @@
+/* murk/math.h — small vector and colour types shared by the core and every plugin.
+ * Header-only (static inline); no dependency beyond <math.h>. */
+#ifndef MURK_MATH_H
+#define MURK_MATH_H
+
+#include <math.h>
+#include <stdint.h>
+
+#define MURK_PI 3.14159265358979323846f
+#define MURK_INV_PI 0.31830988618379067154f
+
+typedef struct murk_vec3 { float x, y, z; } murk_vec3;
+/* Linear RGB; c[0..2] so that trackers can loop over channels. */
+typedef struct murk_rgb { float c[3]; } murk_rgb;
+
+typedef struct murk_ray {
+    murk_vec3 o, d; /* d is unit length */
+    float tmin, tmax;
+} murk_ray;
+
+static inline murk_vec3 murk_v3(float x, float y, float z) { murk_vec3 v = {x, y, z}; return v; }
+static inline murk_vec3 murk_add(murk_vec3 a, murk_vec3 b) { return murk_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline murk_vec3 murk_sub(murk_vec3 a, murk_vec3 b) { return murk_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline murk_vec3 murk_mul(murk_vec3 a, float s) { return murk_v3(a.x * s, a.y * s, a.z * s); }
+static inline murk_vec3 murk_madd(murk_vec3 a, murk_vec3 b, float s) { return murk_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline murk_vec3 murk_neg(murk_vec3 a) { return murk_v3(-a.x, -a.y, -a.z); }
+static inline float murk_dot(murk_vec3 a, murk_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline murk_vec3 murk_cross(murk_vec3 a, murk_vec3 b)
+{
+    return murk_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline float murk_length(murk_vec3 a) { return sqrtf(murk_dot(a, a)); }
+static inline murk_vec3 murk_normalize(murk_vec3 a)
+{
+    float l = murk_length(a);
+    return l > 0.0f ? murk_mul(a, 1.0f / l) : a;
+}
+static inline float murk_v3_get(murk_vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
+
+/* Orthonormal basis around unit n (Duff et al. 2017, branchless). */
+static inline void murk_basis(murk_vec3 n, murk_vec3 *t, murk_vec3 *b)
+{
+    float sign = copysignf(1.0f, n.z);
+    float a = -1.0f / (sign + n.z);
+    float bb = n.x * n.y * a;
+    *t = murk_v3(1.0f + sign * n.x * n.x * a, sign * bb, -sign * n.x);
+    *b = murk_v3(bb, sign + n.y * n.y * a, -n.y);
+}
+static inline murk_vec3 murk_to_local(murk_vec3 v, murk_vec3 t, murk_vec3 b, murk_vec3 n)
+{
+    return murk_v3(murk_dot(v, t), murk_dot(v, b), murk_dot(v, n));
+}
+static inline murk_vec3 murk_from_local(murk_vec3 v, murk_vec3 t, murk_vec3 b, murk_vec3 n)
+{
+    return murk_add(murk_add(murk_mul(t, v.x), murk_mul(b, v.y)), murk_mul(n, v.z));
+}
+
+static inline murk_rgb murk_rgb3(float r, float g, float b) { murk_rgb c = {{r, g, b}}; return c; }
+static inline murk_rgb murk_rgb1(float v) { return murk_rgb3(v, v, v); }
+static inline murk_rgb murk_rgb_add(murk_rgb a, murk_rgb b) { return murk_rgb3(a.c[0] + b.c[0], a.c[1] + b.c[1], a.c[2] + b.c[2]); }
+static inline murk_rgb murk_rgb_mul(murk_rgb a, murk_rgb b) { return murk_rgb3(a.c[0] * b.c[0], a.c[1] * b.c[1], a.c[2] * b.c[2]); }
+static inline murk_rgb murk_rgb_scale(murk_rgb a, float s) { return murk_rgb3(a.c[0] * s, a.c[1] * s, a.c[2] * s); }
+static inline float murk_rgb_max(murk_rgb a) { return fmaxf(a.c[0], fmaxf(a.c[1], a.c[2])); }
+static inline float murk_rgb_avg(murk_rgb a) { return (a.c[0] + a.c[1] + a.c[2]) * (1.0f / 3.0f); }
+static inline float murk_luminance(murk_rgb a) { return 0.2126f * a.c[0] + 0.7152f * a.c[1] + 0.0722f * a.c[2]; }
+static inline int murk_rgb_is_black(murk_rgb a) { return a.c[0] == 0.0f && a.c[1] == 0.0f && a.c[2] == 0.0f; }
+static inline int murk_rgb_finite(murk_rgb a) { return isfinite(a.c[0]) && isfinite(a.c[1]) && isfinite(a.c[2]); }
+
+/* ---- Random numbers -------------------------------------------------------------------------
+ * murk_rng is PCG32 (O'Neill 2014). The core seeds one stream per (seed, pixel, sample) by hashing
+ * those counters, so a sample's numbers never depend on which thread ran it or in which order. */
+typedef struct murk_rng { uint64_t state, inc; } murk_rng;
+
+static inline uint64_t murk_hash64(uint64_t x)
+{ /* splitmix64 finaliser */
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+static inline uint32_t murk_rng_u32(murk_rng *r)
+{
+    uint64_t old = r->state;
+    r->state = old * 6364136223846793005ull + r->inc;
+    uint32_t xs = (uint32_t)(((old >> 18u) ^ old) >> 27u);
+    uint32_t rot = (uint32_t)(old >> 59u);
+    return (xs >> rot) | (xs << ((-rot) & 31u));
+}
+static inline void murk_rng_seed(murk_rng *r, uint64_t a, uint64_t b, uint64_t c)
+{
+    uint64_t h = murk_hash64(a ^ murk_hash64(b ^ murk_hash64(c)));
+    r->state = 0u;
+    r->inc = (murk_hash64(h + 1u) << 1u) | 1u;
+    murk_rng_u32(r);
+    r->state += h;
+    murk_rng_u32(r);
+}
+/* Uniform float in [0, 1): 24 random mantissa bits, never 1. */
+static inline float murk_rng_float(murk_rng *r) { return (float)(murk_rng_u32(r) >> 8) * (1.0f / 16777216.0f); }
+
+#endif

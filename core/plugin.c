@@ -1,0 +1,265 @@
+/* plugin.c — the plugin loader. The ABI version is a data symbol read before any plugin function is
+ * called; then the entry function's descriptor is checked field by field. Every refusal is one line
+ * naming the file and the cause. */
+#include "plugin_loader.h"
+#include "util.h"
+
+#include "murk/integrator.h"
+#include "murk/material.h"
+#include "murk/medium.h"
+
+#include <dlfcn.h>
+#include <stdarg.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+const char *murk_kind_name(int kind)
+{
+    switch (kind) {
+    case MURK_KIND_MATERIAL: return "material";
+    case MURK_KIND_MEDIUM: return "medium";
+    case MURK_KIND_INTEGRATOR: return "integrator";
+    default: return "unknown-kind";
+    }
+}
+
+static void add_dir(murk_registry *r, const char *d, size_t len)
+{
+    if (len == 0)
+        return;
+    char *s = murk_xmalloc(len + 1);
+    memcpy(s, d, len);
+    for (size_t i = 0; i < r->ndirs; i++)
+        if (strcmp(r->dirs[i], s) == 0) {
+            free(s);
+            return;
+        }
+    r->dirs = murk_xrealloc(r->dirs, (r->ndirs + 1) * sizeof *r->dirs);
+    r->dirs[r->ndirs++] = s;
+}
+
+static int running_uninstalled(void)
+{
+    char exe[PATH_MAX], root[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (n <= 0)
+        return 0;
+    exe[n] = 0;
+    if (!realpath(MURK_BUILD_ROOT, root))
+        return 0;
+    size_t rl = strlen(root);
+    return strncmp(exe, root, rl) == 0 && exe[rl] == '/';
+}
+
+void murk_registry_init(murk_registry *r)
+{
+    memset(r, 0, sizeof *r);
+    const char *env = getenv("MURK_PLUGIN_PATH");
+    if (env) {
+        for (const char *p = env;;) {
+            const char *c = strchr(p, ':');
+            add_dir(r, p, c ? (size_t)(c - p) : strlen(p));
+            if (!c)
+                break;
+            p = c + 1;
+        }
+    }
+    const char *d = running_uninstalled() ? MURK_BUILD_PLUGINDIR : MURK_PLUGINDIR;
+    add_dir(r, d, strlen(d));
+}
+
+void murk_plugin_close(murk_plugin *p)
+{
+    if (p->handle)
+        dlclose(p->handle);
+    free(p->path);
+    memset(p, 0, sizeof *p);
+}
+
+void murk_registry_free(murk_registry *r)
+{
+    for (size_t i = 0; i < r->nloaded; i++) {
+        murk_plugin_close(r->loaded[i]);
+        free(r->loaded[i]);
+    }
+    for (size_t i = 0; i < r->ndirs; i++)
+        free(r->dirs[i]);
+    free(r->loaded);
+    free(r->dirs);
+    memset(r, 0, sizeof *r);
+}
+
+static size_t vtable_min_size(int kind)
+{
+    switch (kind) {
+    case MURK_KIND_MATERIAL: return sizeof(murk_material_vt);
+    case MURK_KIND_MEDIUM: return sizeof(murk_medium_vt);
+    case MURK_KIND_INTEGRATOR: return sizeof(murk_integrator_vt);
+    default: return 0;
+    }
+}
+
+static int fail(char *err, size_t errlen, const char *path, const char *fmt, ...) MURK_PRINTF(4, 5);
+static int fail(char *err, size_t errlen, const char *path, const char *fmt, ...)
+{
+    int k = snprintf(err, errlen, "plugin %s: ", path);
+    va_list ap;
+    va_start(ap, fmt);
+    if (k >= 0 && (size_t)k < errlen)
+        vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static int check_params(const murk_plugin_desc *d, const char *path, char *err, size_t errlen)
+{
+    if (d->nparams && !d->params)
+        return fail(err, errlen, path, "descriptor lists %u parameters but no table", d->nparams);
+    for (uint32_t i = 0; i < d->nparams; i++) {
+        const murk_param *p = &d->params[i];
+        if (!p->name || !*p->name)
+            return fail(err, errlen, path, "parameter %u has no name", i);
+        if (p->type < MURK_PARAM_FLOAT || p->type > MURK_PARAM_ENUM)
+            return fail(err, errlen, path, "parameter '%s' has unknown type %u", p->name, p->type);
+        if (p->type == MURK_PARAM_ENUM && (!p->choices || !p->def_str))
+            return fail(err, errlen, path, "enum parameter '%s' needs choices and a default", p->name);
+        if (!p->doc)
+            return fail(err, errlen, path, "parameter '%s' has no doc line", p->name);
+        if (strcmp(p->name, "type") == 0)
+            return fail(err, errlen, path, "parameter name 'type' is reserved");
+        for (uint32_t j = 0; j < i; j++)
+            if (strcmp(d->params[j].name, p->name) == 0)
+                return fail(err, errlen, path, "parameter '%s' declared twice", p->name);
+    }
+    return 0;
+}
+
+int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, size_t errlen)
+{
+    memset(out, 0, sizeof *out);
+    dlerror();
+    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!h)
+        return fail(err, errlen, path, "cannot load: %s", dlerror());
+    const murk_abi *abi = dlsym(h, MURK_PLUGIN_ABI_SYMBOL);
+    if (!abi) {
+        dlclose(h);
+        return fail(err, errlen, path, "no '%s' symbol: not a murk plugin", MURK_PLUGIN_ABI_SYMBOL);
+    }
+    if (abi->major != MURK_ABI_MAJOR) {
+        fail(err, errlen, path, "built for plugin ABI %u.%u, this murk has ABI %d.%d (major versions differ: rebuild the plugin)",
+             abi->major, abi->minor, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        dlclose(h);
+        return -1;
+    }
+    if (abi->minor > MURK_ABI_MINOR) {
+        fail(err, errlen, path, "needs plugin ABI %u.%u, this murk has ABI %d.%d (upgrade murk)", abi->major, abi->minor,
+             MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        dlclose(h);
+        return -1;
+    }
+    murk_abi abicopy = *abi;
+    union {
+        void *obj;
+        const murk_plugin_desc *(*fn)(void);
+    } entry;
+    entry.obj = dlsym(h, MURK_PLUGIN_ENTRY_SYMBOL);
+    if (!entry.obj) {
+        dlclose(h);
+        return fail(err, errlen, path, "no '%s' function", MURK_PLUGIN_ENTRY_SYMBOL);
+    }
+    const murk_plugin_desc *d = entry.fn();
+    int rc = 0;
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    size_t blen = strlen(base);
+    if (blen > 3 && strcmp(base + blen - 3, ".so") == 0)
+        blen -= 3;
+    if (!d)
+        rc = fail(err, errlen, path, "%s() returned no descriptor", MURK_PLUGIN_ENTRY_SYMBOL);
+    else if (d->struct_size != sizeof(murk_plugin_desc))
+        rc = fail(err, errlen, path, "descriptor struct_size is %u bytes, expected %zu for ABI %u.%u", d->struct_size,
+                  sizeof(murk_plugin_desc), abicopy.major, abicopy.minor);
+    else if (d->kind < MURK_KIND_MATERIAL || d->kind > MURK_KIND_INTEGRATOR)
+        rc = fail(err, errlen, path, "unknown plugin kind %u", d->kind);
+    else if (!d->name || strlen(d->name) != blen || strncmp(d->name, base, blen) != 0)
+        rc = fail(err, errlen, path, "declares the name '%s' but its file is named '%.*s.so' (names must match)",
+                  d->name ? d->name : "(null)", (int)blen, base);
+    else if (kind && (int)d->kind != kind)
+        rc = fail(err, errlen, path, "'%s' is a %s plugin, not a %s", d->name, murk_kind_name((int)d->kind),
+                  murk_kind_name(kind));
+    else if (!d->vtable)
+        rc = fail(err, errlen, path, "descriptor has no vtable");
+    else if (*(const uint32_t *)d->vtable < vtable_min_size((int)d->kind))
+        rc = fail(err, errlen, path, "%s vtable is %u bytes, expected at least %zu", murk_kind_name((int)d->kind),
+                  *(const uint32_t *)d->vtable, vtable_min_size((int)d->kind));
+    else
+        rc = check_params(d, path, err, errlen);
+    if (rc == 0 && !d->description)
+        rc = fail(err, errlen, path, "descriptor has no description");
+    if (rc != 0) {
+        dlclose(h);
+        return -1;
+    }
+    out->path = murk_strdup(path);
+    out->handle = h;
+    out->desc = d;
+    out->abi = abicopy;
+    return 0;
+}
+
+static int valid_name(const char *name)
+{
+    if (!*name || strlen(name) > 64)
+        return 0;
+    for (const char *c = name; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_' || *c == '-'))
+            return 0;
+    return 1;
+}
+
+const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *name, char *err, size_t errlen)
+{
+    for (size_t i = 0; i < r->nloaded; i++)
+        if (strcmp(r->loaded[i]->desc->name, name) == 0) {
+            const murk_plugin *p = r->loaded[i];
+            if (kind && (int)p->desc->kind != kind) {
+                fail(err, errlen, p->path, "'%s' is a %s plugin, not a %s", name, murk_kind_name((int)p->desc->kind),
+                     murk_kind_name(kind));
+                return NULL;
+            }
+            return p;
+        }
+    if (!valid_name(name)) {
+        snprintf(err, errlen, "'%s' is not a plugin name (letters, digits, '_' and '-' only)", name);
+        return NULL;
+    }
+    for (size_t i = 0; i < r->ndirs; i++) {
+        size_t n = strlen(r->dirs[i]) + strlen(name) + 8;
+        char *path = murk_xmalloc(n);
+        snprintf(path, n, "%s/%s.so", r->dirs[i], name);
+        if (access(path, F_OK) != 0) {
+            free(path);
+            continue;
+        }
+        murk_plugin *p = murk_xmalloc(sizeof *p);
+        int rc = murk_plugin_open(path, kind, p, err, errlen);
+        free(path);
+        if (rc != 0) {
+            free(p);
+            return NULL;
+        }
+        r->loaded = murk_xrealloc(r->loaded, (r->nloaded + 1) * sizeof *r->loaded);
+        r->loaded[r->nloaded++] = p;
+        return p;
+    }
+    int k = snprintf(err, errlen, "no %s%splugin '%s' (searched", kind ? murk_kind_name(kind) : "", kind ? " " : "", name);
+    for (size_t i = 0; i < r->ndirs && k > 0 && (size_t)k < errlen; i++)
+        k += snprintf(err + k, errlen - (size_t)k, "%s %s", i ? "," : "", r->dirs[i]);
+    if (k > 0 && (size_t)k < errlen)
+        snprintf(err + k, errlen - (size_t)k, ")");
+    return NULL;
+}

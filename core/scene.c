@@ -1,0 +1,818 @@
+/* scene.c — loading and validating a YAML scene, instantiating the plugins it names.
+ *
+ * Every key is checked: the core's own blocks against the tables below, plugin blocks against the
+ * plugin's parameter schema. Every error is one line "file:line:col: what is wrong". Only the plugins
+ * the scene names are loaded. */
+#include "scene.h"
+#include "host.h"
+#include "obj.h"
+#include "texture.h"
+#include "util.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define ERR(node, ...) murk_yerr(err, errlen, (node), __VA_ARGS__)
+
+/* ---- Typed value readers ------------------------------------------------------------------- */
+
+static int read_number(const murk_ynode *n, const char *what, double *out, char *err, size_t errlen)
+{
+    if (n->kind != MURK_Y_SCALAR)
+        return ERR(n, "%s must be a number, got a %s", what, n->kind == MURK_Y_MAP ? "map" : "list");
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(n->str, &end);
+    if (!*n->str || *end || errno == ERANGE || !isfinite(v))
+        return ERR(n, "%s must be a number, got '%s'", what, n->str);
+    *out = v;
+    return 0;
+}
+
+static int read_range(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err,
+                      size_t errlen)
+{
+    if (read_number(n, what, out, err, errlen))
+        return -1;
+    if (*out < lo || *out > hi)
+        return ERR(n, "%s must be in [%g, %g], got %g", what, lo, hi, *out);
+    return 0;
+}
+
+static int read_int(const murk_ynode *n, const char *what, double lo, double hi, long long *out, char *err,
+                    size_t errlen)
+{
+    double v = 0;
+    if (read_number(n, what, &v, err, errlen))
+        return -1;
+    if (v != floor(v))
+        return ERR(n, "%s must be a whole number, got '%s'", what, n->str);
+    if (v < lo || v > hi)
+        return ERR(n, "%s must be in [%.0f, %.0f], got %s", what, lo, hi, n->str);
+    *out = (long long)v;
+    return 0;
+}
+
+static int read_bool(const murk_ynode *n, const char *what, int *out, char *err, size_t errlen)
+{
+    if (n->kind == MURK_Y_SCALAR) {
+        if (!strcmp(n->str, "true") || !strcmp(n->str, "yes") || !strcmp(n->str, "on")) {
+            *out = 1;
+            return 0;
+        }
+        if (!strcmp(n->str, "false") || !strcmp(n->str, "no") || !strcmp(n->str, "off")) {
+            *out = 0;
+            return 0;
+        }
+    }
+    return ERR(n, "%s must be true or false", what);
+}
+
+/* A fixed-length list of numbers in [lo, hi]. */
+static int read_list(const murk_ynode *n, const char *what, int len, double lo, double hi, double *out, char *err,
+                     size_t errlen)
+{
+    if (n->kind != MURK_Y_SEQ || n->n != (size_t)len)
+        return ERR(n, "%s must be a list of %d numbers", what, len);
+    for (int i = 0; i < len; i++)
+        if (read_range(n->items[i], what, lo, hi, &out[i], err, errlen))
+            return -1;
+    return 0;
+}
+
+static int read_vec3(const murk_ynode *n, const char *what, murk_vec3 *v, char *err, size_t errlen)
+{
+    double d[3];
+    if (read_list(n, what, 3, -1e30, 1e30, d, err, errlen))
+        return -1;
+    *v = murk_v3((float)d[0], (float)d[1], (float)d[2]);
+    return 0;
+}
+
+/* RGB: [r, g, b] or one number for grey. */
+static int read_rgb(const murk_ynode *n, const char *what, double lo, double hi, double out[3], char *err,
+                    size_t errlen)
+{
+    if (n->kind == MURK_Y_SCALAR) {
+        if (read_range(n, what, lo, hi, &out[0], err, errlen))
+            return -1;
+        out[1] = out[2] = out[0];
+        return 0;
+    }
+    if (n->kind != MURK_Y_SEQ || n->n != 3)
+        return ERR(n, "%s must be [r, g, b] or one number", what);
+    return read_list(n, what, 3, lo, hi, out, err, errlen);
+}
+
+static murk_rgb to_rgb(const double d[3]) { return murk_rgb3((float)d[0], (float)d[1], (float)d[2]); }
+
+static int read_string(const murk_ynode *n, const char *what, const char **out, char *err, size_t errlen)
+{
+    if (n->kind != MURK_Y_SCALAR || !*n->str)
+        return ERR(n, "%s must be a name or a path", what);
+    *out = n->str;
+    return 0;
+}
+
+static int expect_map(const murk_ynode *n, const char *what, char *err, size_t errlen)
+{
+    if (!n || n->kind != MURK_Y_MAP)
+        return ERR(n, "%s must be a map of keys", what);
+    return 0;
+}
+
+/* Refuses any key of map that is not in allowed[], suggesting the closest. */
+static int check_keys(const murk_ynode *map, const char *what, const char *const *allowed, size_t nallowed,
+                      char *err, size_t errlen)
+{
+    for (size_t i = 0; i < map->n; i++) {
+        int ok = 0;
+        for (size_t j = 0; j < nallowed && !ok; j++)
+            ok = strcmp(map->keys[i], allowed[j]) == 0;
+        if (ok)
+            continue;
+        const char *s = murk_did_you_mean(map->keys[i], allowed, nallowed);
+        if (s)
+            return murk_yerr_key(err, errlen, map, i, "unknown key '%s' in %s (did you mean '%s'?)", map->keys[i], what, s);
+        int k = murk_yerr_key(err, errlen, map, i, "unknown key '%s' in %s; expected one of:", map->keys[i], what);
+        size_t len = strlen(err);
+        for (size_t j = 0; j < nallowed && len < errlen; j++)
+            len += (size_t)snprintf(err + len, errlen - len, "%s %s", j ? "," : "", allowed[j]);
+        return k;
+    }
+    return 0;
+}
+
+static const murk_ynode *require(const murk_ynode *map, const char *key, const char *what, char *err, size_t errlen)
+{
+    const murk_ynode *n = murk_ymap_get(map, key);
+    if (!n)
+        murk_yerr(err, errlen, map, "%s is missing the required key '%s'", what, key);
+    return n;
+}
+
+#define NKEYS(a) (sizeof(a) / sizeof((a)[0]))
+
+/* ---- Plugin parameters ----------------------------------------------------------------------- */
+
+static murk_value *keep_params(murk_scene *s, size_t n)
+{
+    murk_value *v = murk_xmalloc((n ? n : 1) * sizeof *v);
+    s->param_store = murk_xrealloc(s->param_store, (s->nparam_store + 1) * sizeof *s->param_store);
+    s->param_store[s->nparam_store++] = v;
+    return v;
+}
+
+static int choice_index(const char *choices, const char *word)
+{
+    int idx = 0;
+    size_t wl = strlen(word);
+    for (const char *c = choices;; idx++) {
+        const char *bar = strchr(c, '|');
+        size_t len = bar ? (size_t)(bar - c) : strlen(c);
+        if (len == wl && strncmp(c, word, len) == 0)
+            return idx;
+        if (!bar)
+            return -1;
+        c = bar + 1;
+    }
+}
+
+/* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
+ * block in messages, e.g. "material 'metal' (ggx)". */
+static int read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
+                              const char *const *skip, size_t nskip, murk_value *values, char *err, size_t errlen)
+{
+    for (uint32_t i = 0; i < d->nparams; i++) {
+        const murk_param *p = &d->params[i];
+        murk_value *v = &values[i];
+        memset(v, 0, sizeof *v);
+        memcpy(v->f, p->def, sizeof v->f);
+        v->s = p->def_str;
+        if (p->type == MURK_PARAM_ENUM)
+            v->choice = choice_index(p->choices, p->def_str);
+    }
+    for (size_t k = 0; k < map->n; k++) {
+        const char *key = map->keys[k];
+        int skipped = 0;
+        for (size_t j = 0; j < nskip && !skipped; j++)
+            skipped = strcmp(skip[j], key) == 0;
+        if (skipped)
+            continue;
+        int idx = -1;
+        for (uint32_t i = 0; i < d->nparams; i++)
+            if (strcmp(d->params[i].name, key) == 0)
+                idx = (int)i;
+        if (idx < 0) {
+            const char *cand[96];
+            size_t nc = 0;
+            for (uint32_t i = 0; i < d->nparams && nc < 96; i++)
+                cand[nc++] = d->params[i].name;
+            for (size_t j = 0; j < nskip && nc < 96; j++)
+                cand[nc++] = skip[j];
+            const char *sug = murk_did_you_mean(key, cand, nc);
+            if (sug)
+                return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (did you mean '%s'?)", key, who, sug);
+            return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (see: murk plugins %s)", key, who,
+                                 d->name);
+        }
+        const murk_param *p = &d->params[idx];
+        murk_value *v = &values[idx];
+        const murk_ynode *n = map->items[k];
+        char what[256];
+        snprintf(what, sizeof what, "%s: parameter '%s'", who, key);
+        v->set = 1;
+        long long iv = 0;
+        int bv = 0;
+        switch (p->type) {
+        case MURK_PARAM_FLOAT:
+        case MURK_PARAM_RGB:
+            if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE)) {
+                murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
+                if (!t)
+                    return -1;
+                s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
+                s->textures[s->ntextures++] = t;
+                v->tex = t;
+                murk_texture_average(t, v->f);
+            } else if (n->kind == MURK_Y_MAP) {
+                return ERR(n, "%s does not take a texture", what);
+            } else if (p->type == MURK_PARAM_FLOAT) {
+                if (read_range(n, what, p->min, p->max, &v->f[0], err, errlen))
+                    return -1;
+                v->f[1] = v->f[2] = v->f[0];
+            } else if (read_rgb(n, what, p->min, p->max, v->f, err, errlen)) {
+                return -1;
+            }
+            break;
+        case MURK_PARAM_INT:
+            if (read_int(n, what, p->min, p->max, &iv, err, errlen))
+                return -1;
+            v->f[0] = (double)iv;
+            break;
+        case MURK_PARAM_BOOL:
+            if (read_bool(n, what, &bv, err, errlen))
+                return -1;
+            v->f[0] = bv;
+            break;
+        case MURK_PARAM_STRING:
+            if (read_string(n, what, &v->s, err, errlen))
+                return -1;
+            break;
+        case MURK_PARAM_ENUM:
+            if (n->kind != MURK_Y_SCALAR || (v->choice = choice_index(p->choices, n->str)) < 0)
+                return ERR(n, "%s must be one of %s, got '%s'", what, p->choices, n->kind == MURK_Y_SCALAR ? n->str : "a list");
+            v->s = n->str;
+            break;
+        default:
+            return ERR(n, "%s has an unknown type", what);
+        }
+    }
+    for (uint32_t i = 0; i < d->nparams; i++)
+        if ((d->params[i].flags & MURK_PARAM_REQUIRED) && !values[i].set)
+            return murk_yerr(err, errlen, map, "%s is missing the required parameter '%s'", who, d->params[i].name);
+    return 0;
+}
+
+/* Prefixes an error that create() returned with the block's location. */
+static int create_failed(const murk_ynode *n, const char *who, const char *msg, char *err, size_t errlen)
+{
+    return ERR(n, "%s: %s", who, msg[0] ? msg : "create() failed");
+}
+
+/* ---- Blocks ------------------------------------------------------------------------------------ */
+
+static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"resolution", "spp", "seed", "exposure"};
+    s->width = s->height = 512;
+    s->spp = 64;
+    s->seed = 0;
+    s->exposure = 0.0f;
+    if (!n)
+        return 0;
+    if (expect_map(n, "render", err, errlen) || check_keys(n, "render", keys, NKEYS(keys), err, errlen))
+        return -1;
+    const murk_ynode *c;
+    long long v;
+    if ((c = murk_ymap_get(n, "resolution"))) {
+        double r[2];
+        if (read_list(c, "render.resolution", 2, 1, 16384, r, err, errlen))
+            return -1;
+        if (r[0] != floor(r[0]) || r[1] != floor(r[1]))
+            return ERR(c, "render.resolution must be whole numbers");
+        s->width = (int)r[0];
+        s->height = (int)r[1];
+    }
+    if ((c = murk_ymap_get(n, "spp"))) {
+        if (read_int(c, "render.spp", 1, 1 << 24, &v, err, errlen))
+            return -1;
+        s->spp = (int)v;
+    }
+    if ((c = murk_ymap_get(n, "seed"))) {
+        if (read_int(c, "render.seed", 0, 9007199254740992.0, &v, err, errlen))
+            return -1;
+        s->seed = (uint64_t)v;
+    }
+    if ((c = murk_ymap_get(n, "exposure"))) {
+        double e;
+        if (read_range(c, "render.exposure", -30, 30, &e, err, errlen))
+            return -1;
+        s->exposure = (float)e;
+    }
+    return 0;
+}
+
+static const murk_named_medium *find_medium(const murk_scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->nmedia; i++)
+        if (strcmp(s->media[i].name, name) == 0)
+            return &s->media[i];
+    return NULL;
+}
+
+static int lookup_medium(const murk_scene *s, const murk_ynode *n, const murk_medium **out, char *err, size_t errlen)
+{
+    const char *name = NULL;
+    if (read_string(n, "a medium reference", &name, err, errlen))
+        return -1;
+    const murk_named_medium *m = find_medium(s, name);
+    if (m) {
+        *out = &m->m;
+        return 0;
+    }
+    const char *cand[256];
+    size_t nc = 0;
+    for (size_t i = 0; i < s->nmedia && nc < 256; i++)
+        cand[nc++] = s->media[i].name;
+    const char *sug = murk_did_you_mean(name, cand, nc);
+    if (sug)
+        return ERR(n, "undefined medium '%s' (did you mean '%s'?)", name, sug);
+    return ERR(n, "undefined medium '%s'", name);
+}
+
+static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"from", "at", "up", "fov", "medium"};
+    s->cam_from = murk_v3(0, 0, 5);
+    s->cam_at = murk_v3(0, 0, 0);
+    s->cam_up = murk_v3(0, 1, 0);
+    s->fov = 40.0f;
+    if (n) {
+        if (expect_map(n, "camera", err, errlen) || check_keys(n, "camera", keys, NKEYS(keys), err, errlen))
+            return -1;
+        const murk_ynode *c;
+        if ((c = murk_ymap_get(n, "from")) && read_vec3(c, "camera.from", &s->cam_from, err, errlen))
+            return -1;
+        if ((c = murk_ymap_get(n, "at")) && read_vec3(c, "camera.at", &s->cam_at, err, errlen))
+            return -1;
+        if ((c = murk_ymap_get(n, "up")) && read_vec3(c, "camera.up", &s->cam_up, err, errlen))
+            return -1;
+        double fov;
+        if ((c = murk_ymap_get(n, "fov"))) {
+            if (read_range(c, "camera.fov", 0.01, 179.0, &fov, err, errlen))
+                return -1;
+            s->fov = (float)fov;
+        }
+        if ((c = murk_ymap_get(n, "medium")) && lookup_medium(s, c, &s->camera_medium, err, errlen))
+            return -1;
+    }
+    murk_vec3 w = murk_sub(s->cam_at, s->cam_from);
+    if (murk_length(w) <= 0.0f)
+        return ERR(n, "camera: 'from' and 'at' are the same point");
+    s->cam_w = murk_normalize(w);
+    murk_vec3 u = murk_cross(s->cam_w, s->cam_up);
+    if (murk_length(u) < 1e-6f * murk_length(s->cam_up) || murk_length(s->cam_up) <= 0.0f)
+        return ERR(n, "camera: 'up' is parallel to the viewing direction");
+    s->cam_u = murk_normalize(u);
+    s->cam_v = murk_cross(s->cam_u, s->cam_w);
+    s->cam_tan = tanf(0.5f * s->fov * MURK_PI / 180.0f);
+    return 0;
+}
+
+static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    if (!n)
+        return 0;
+    if (expect_map(n, "materials", err, errlen))
+        return -1;
+    s->materials = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->materials);
+    for (size_t i = 0; i < n->n; i++) {
+        const murk_ynode *m = n->items[i];
+        char who[256];
+        snprintf(who, sizeof who, "material '%s'", n->keys[i]);
+        if (expect_map(m, who, err, errlen))
+            return -1;
+        const murk_ynode *t = require(m, "type", who, err, errlen);
+        const char *type = NULL;
+        if (!t || read_string(t, "type", &type, err, errlen))
+            return -1;
+        char lerr[1024];
+        const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_MATERIAL, type, lerr, sizeof lerr);
+        if (!p)
+            return ERR(t, "%s: %s", who, lerr);
+        snprintf(who, sizeof who, "material '%s' (%s)", n->keys[i], type);
+        static const char *const skip[] = {"type"};
+        murk_value *vals = keep_params(s, p->desc->nparams);
+        if (read_plugin_params(s, p->desc, m, who, skip, 1, vals, err, errlen))
+            return -1;
+        murk_named_material *nm = &s->materials[s->nmaterials];
+        const murk_material_vt *vt = p->desc->vtable;
+        char cerr[512] = "";
+        void *self = NULL;
+        if (vt->create(murk_host_table(), vals, &self, cerr, sizeof cerr) != 0)
+            return create_failed(m, who, cerr, err, errlen);
+        nm->name = murk_strdup(n->keys[i]);
+        nm->m.vt = vt;
+        nm->m.self = self;
+        nm->m.name = nm->name;
+        nm->plugin = p;
+        s->nmaterials++;
+    }
+    return 0;
+}
+
+static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    static const char *const skip[] = {"type"};
+    static const murk_ynode empty = {.kind = MURK_Y_MAP, .file = "(default)", .line = 1, .col = 1};
+    const char *type = "path";
+    if (n) {
+        if (expect_map(n, "integrator", err, errlen))
+            return -1;
+        const murk_ynode *t = require(n, "type", "integrator", err, errlen);
+        if (!t || read_string(t, "integrator.type", &type, err, errlen))
+            return -1;
+    } else {
+        n = &empty;
+    }
+    char lerr[1024], who[256];
+    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_INTEGRATOR, type, lerr, sizeof lerr);
+    if (!p) {
+        const murk_ynode *t = murk_ymap_get(n, "type");
+        return ERR(t ? t : n, "integrator: %s", lerr);
+    }
+    snprintf(who, sizeof who, "integrator '%s'", type);
+    murk_value *vals = keep_params(s, p->desc->nparams);
+    if (read_plugin_params(s, p->desc, n, who, skip, 1, vals, err, errlen))
+        return -1;
+    const murk_integrator_vt *vt = p->desc->vtable;
+    char cerr[512] = "";
+    if (vt->create(murk_host_table(), vals, &s->integrator, cerr, sizeof cerr) != 0)
+        return create_failed(n, who, cerr, err, errlen);
+    s->integrator_plugin = p;
+    s->integrator_vt = vt;
+    return 0;
+}
+
+static const murk_material *find_material(const murk_scene *s, const char *name)
+{
+    for (size_t i = 0; i < s->nmaterials; i++)
+        if (strcmp(s->materials[i].name, name) == 0)
+            return &s->materials[i].m;
+    return NULL;
+}
+
+static int lookup_material(const murk_scene *s, const murk_ynode *n, const murk_material **out, char *err,
+                           size_t errlen)
+{
+    const char *name = NULL;
+    if (read_string(n, "material", &name, err, errlen))
+        return -1;
+    if ((*out = find_material(s, name)))
+        return 0;
+    const char *cand[256];
+    size_t nc = 0;
+    for (size_t i = 0; i < s->nmaterials && nc < 256; i++)
+        cand[nc++] = s->materials[i].name;
+    const char *sug = murk_did_you_mean(name, cand, nc);
+    if (sug)
+        return ERR(n, "undefined material '%s' (did you mean '%s'?)", name, sug);
+    return ERR(n, "undefined material '%s'", name);
+}
+
+/* ---- Shapes ---------------------------------------------------------------------------------- */
+
+static void shape_alloc(murk_shape *sh, uint32_t nverts, uint32_t ntris, int with_uv)
+{
+    sh->nverts = nverts;
+    sh->ntris = ntris;
+    sh->pos = murk_xmalloc(3u * nverts * sizeof(float));
+    sh->uv = with_uv ? murk_xmalloc(2u * nverts * sizeof(float)) : NULL;
+    sh->idx = murk_xmalloc(3u * ntris * sizeof(uint32_t));
+}
+
+/* Appends quad center +- u +- v as two triangles whose normal is u x v, with uv in [0,1]^2. */
+static void put_quad(murk_shape *sh, uint32_t q, murk_vec3 c, murk_vec3 u, murk_vec3 v)
+{
+    murk_vec3 p[4] = {murk_sub(murk_sub(c, u), v), murk_sub(murk_add(c, u), v), murk_add(murk_add(c, u), v),
+                      murk_add(murk_sub(c, u), v)};
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    for (int i = 0; i < 4; i++) {
+        float *dst = &sh->pos[3u * (4u * q + (uint32_t)i)];
+        dst[0] = p[i].x;
+        dst[1] = p[i].y;
+        dst[2] = p[i].z;
+        sh->uv[2u * (4u * q + (uint32_t)i)] = uv[2 * i];
+        sh->uv[2u * (4u * q + (uint32_t)i) + 1] = uv[2 * i + 1];
+    }
+    uint32_t b = 4u * q, *t = &sh->idx[6u * q];
+    t[0] = b, t[1] = b + 1, t[2] = b + 2;
+    t[3] = b, t[4] = b + 2, t[5] = b + 3;
+}
+
+static int read_transform(const murk_ynode *n, float m[12], char *err, size_t errlen)
+{
+    static const char *const keys[] = {"scale", "rotate", "translate"};
+    if (expect_map(n, "transform", err, errlen) || check_keys(n, "transform", keys, NKEYS(keys), err, errlen))
+        return -1;
+    double sc[3] = {1, 1, 1}, rot[3] = {0, 0, 0}, tr[3] = {0, 0, 0};
+    const murk_ynode *c;
+    if ((c = murk_ymap_get(n, "scale")) && read_rgb(c, "transform.scale", -1e30, 1e30, sc, err, errlen))
+        return -1;
+    if ((c = murk_ymap_get(n, "rotate")) && read_list(c, "transform.rotate", 3, -1e6, 1e6, rot, err, errlen))
+        return -1;
+    if ((c = murk_ymap_get(n, "translate")) && read_list(c, "transform.translate", 3, -1e30, 1e30, tr, err, errlen))
+        return -1;
+    if (sc[0] == 0 || sc[1] == 0 || sc[2] == 0)
+        return ERR(murk_ymap_get(n, "scale"), "transform.scale must not be 0");
+    /* M = T * Rz * Ry * Rx * S (rotate: degrees about x, then y, then z) */
+    double a = rot[0] * M_PI / 180, b = rot[1] * M_PI / 180, g = rot[2] * M_PI / 180;
+    double ca = cos(a), sa = sin(a), cb = cos(b), sb = sin(b), cg = cos(g), sg = sin(g);
+    double R[3][3] = {{cg * cb, cg * sb * sa - sg * ca, cg * sb * ca + sg * sa},
+                      {sg * cb, sg * sb * sa + cg * ca, sg * sb * ca - cg * sa},
+                      {-sb, cb * sa, cb * ca}};
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++)
+            m[4 * r + k] = (float)(R[r][k] * sc[k]);
+        m[4 * r + 3] = (float)tr[r];
+    }
+    return 0;
+}
+
+static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *err, size_t errlen)
+{
+    const murk_ynode *f = require(n, "file", "mesh shape", err, errlen);
+    const char *file = NULL;
+    if (!f || read_string(f, "mesh.file", &file, err, errlen))
+        return -1;
+    float m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    const murk_ynode *t = murk_ymap_get(n, "transform");
+    if (t && read_transform(t, m, err, errlen))
+        return -1;
+    char *path = murk_path_relative_to(s->doc.file, file);
+    murk_mesh mesh;
+    char merr[768];
+    int rc = murk_obj_load(path, &mesh, merr, sizeof merr);
+    free(path);
+    if (rc != 0)
+        return ERR(f, "mesh: %s", merr);
+    sh->nverts = mesh.nverts;
+    sh->ntris = mesh.ntris;
+    sh->pos = mesh.pos;
+    sh->uv = mesh.uv;
+    sh->nrm = mesh.nrm;
+    sh->idx = mesh.idx;
+    for (uint32_t i = 0; i < mesh.nverts; i++) {
+        float *p = &sh->pos[3 * i], x = p[0], y = p[1], z = p[2];
+        for (int r = 0; r < 3; r++)
+            p[r] = m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z + m[4 * r + 3];
+        if (sh->nrm) { /* normals transform by the inverse transpose: R S^-1 for M = R S */
+            float *q = &sh->nrm[3 * i], nx = q[0], ny = q[1], nz = q[2];
+            murk_vec3 c0 = murk_v3(m[0], m[4], m[8]), c1 = murk_v3(m[1], m[5], m[9]), c2 = murk_v3(m[2], m[6], m[10]);
+            float l0 = murk_dot(c0, c0), l1 = murk_dot(c1, c1), l2 = murk_dot(c2, c2);
+            murk_vec3 o = murk_add(murk_add(murk_mul(c0, nx / l0), murk_mul(c1, ny / l1)), murk_mul(c2, nz / l2));
+            o = murk_normalize(o);
+            q[0] = o.x, q[1] = o.y, q[2] = o.z;
+        }
+    }
+    /* a mirroring transform flips the winding: keep normals pointing the way the file meant */
+    float det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+                m[2] * (m[4] * m[9] - m[5] * m[8]);
+    if (det < 0)
+        for (uint32_t i = 0; i < sh->ntris; i++) {
+            uint32_t tmp = sh->idx[3 * i + 1];
+            sh->idx[3 * i + 1] = sh->idx[3 * i + 2];
+            sh->idx[3 * i + 2] = tmp;
+        }
+    return 0;
+}
+
+static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *err, size_t errlen)
+{
+    static const char *const common[] = {"type", "material", "emission", "interior", "exterior"};
+    static const char *const quad_keys[] = {"type", "material", "emission", "interior", "exterior", "center", "u", "v"};
+    static const char *const sphere_keys[] = {"type", "material", "emission", "interior", "exterior", "center", "radius"};
+    static const char *const box_keys[] = {"type", "material", "emission", "interior", "exterior", "min", "max"};
+    static const char *const mesh_keys[] = {"type", "material", "emission", "interior", "exterior", "file", "transform"};
+    static const char *const types[] = {"quad", "sphere", "box", "mesh"};
+    (void)common;
+    if (expect_map(n, "a shape", err, errlen))
+        return -1;
+    const murk_ynode *t = require(n, "type", "shape", err, errlen);
+    const char *type = NULL;
+    if (!t || read_string(t, "shape type", &type, err, errlen))
+        return -1;
+    const murk_ynode *c;
+    if (!strcmp(type, "quad")) {
+        sh->type = MURK_SHAPE_QUAD;
+        if (check_keys(n, "quad", quad_keys, NKEYS(quad_keys), err, errlen))
+            return -1;
+        murk_vec3 ce, u, v;
+        if (!(c = require(n, "center", "quad", err, errlen)) || read_vec3(c, "quad.center", &ce, err, errlen))
+            return -1;
+        if (!(c = require(n, "u", "quad", err, errlen)) || read_vec3(c, "quad.u", &u, err, errlen))
+            return -1;
+        if (!(c = require(n, "v", "quad", err, errlen)) || read_vec3(c, "quad.v", &v, err, errlen))
+            return -1;
+        if (murk_length(murk_cross(u, v)) <= 0.0f)
+            return ERR(n, "quad: u and v must span a non-degenerate parallelogram");
+        shape_alloc(sh, 4, 2, 1);
+        put_quad(sh, 0, ce, u, v);
+    } else if (!strcmp(type, "sphere")) {
+        sh->type = MURK_SHAPE_SPHERE;
+        if (check_keys(n, "sphere", sphere_keys, NKEYS(sphere_keys), err, errlen))
+            return -1;
+        double r;
+        if (!(c = require(n, "center", "sphere", err, errlen)) || read_vec3(c, "sphere.center", &sh->center, err, errlen))
+            return -1;
+        if (!(c = require(n, "radius", "sphere", err, errlen)) || read_range(c, "sphere.radius", 1e-6, 1e30, &r, err, errlen))
+            return -1;
+        sh->radius = (float)r;
+    } else if (!strcmp(type, "box")) {
+        sh->type = MURK_SHAPE_BOX;
+        if (check_keys(n, "box", box_keys, NKEYS(box_keys), err, errlen))
+            return -1;
+        murk_vec3 lo, hi;
+        if (!(c = require(n, "min", "box", err, errlen)) || read_vec3(c, "box.min", &lo, err, errlen))
+            return -1;
+        if (!(c = require(n, "max", "box", err, errlen)) || read_vec3(c, "box.max", &hi, err, errlen))
+            return -1;
+        if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
+            return ERR(c, "box: max must exceed min on every axis");
+        murk_vec3 ce = murk_mul(murk_add(lo, hi), 0.5f), h = murk_mul(murk_sub(hi, lo), 0.5f);
+        murk_vec3 X = murk_v3(h.x, 0, 0), Y = murk_v3(0, h.y, 0), Z = murk_v3(0, 0, h.z);
+        shape_alloc(sh, 24, 12, 1);
+        /* six faces, normals outwards: (u x v) along the face's outward axis */
+        put_quad(sh, 0, murk_add(ce, X), Y, Z);
+        put_quad(sh, 1, murk_sub(ce, X), Z, Y);
+        put_quad(sh, 2, murk_add(ce, Y), Z, X);
+        put_quad(sh, 3, murk_sub(ce, Y), X, Z);
+        put_quad(sh, 4, murk_add(ce, Z), X, Y);
+        put_quad(sh, 5, murk_sub(ce, Z), Y, X);
+    } else if (!strcmp(type, "mesh")) {
+        sh->type = MURK_SHAPE_MESH;
+        if (check_keys(n, "mesh", mesh_keys, NKEYS(mesh_keys), err, errlen) || load_mesh(s, sh, n, err, errlen))
+            return -1;
+    } else {
+        const char *sug = murk_did_you_mean(type, types, NKEYS(types));
+        if (sug)
+            return ERR(t, "unknown shape type '%s' (did you mean '%s'?)", type, sug);
+        return ERR(t, "unknown shape type '%s'; expected quad, sphere, box or mesh", type);
+    }
+    if ((c = murk_ymap_get(n, "material")) && lookup_material(s, c, &sh->material, err, errlen))
+        return -1;
+    if ((c = murk_ymap_get(n, "interior")) && lookup_medium(s, c, &sh->interior, err, errlen))
+        return -1;
+    if ((c = murk_ymap_get(n, "exterior")) && lookup_medium(s, c, &sh->exterior, err, errlen))
+        return -1;
+    if ((c = murk_ymap_get(n, "emission"))) {
+        double e[3];
+        if (read_rgb(c, "emission", 0, 1e30, e, err, errlen))
+            return -1;
+        sh->emission = to_rgb(e);
+    }
+    if (!sh->material && !murk_ymap_get(n, "interior"))
+        return ERR(n, "%s has no material (give one, or interior: MEDIUM for an index-matched medium boundary)", type);
+    if (!sh->material && !murk_rgb_is_black(sh->emission))
+        return ERR(murk_ymap_get(n, "emission"), "an emissive %s needs a material", type);
+    return 0;
+}
+
+static void shape_free(murk_shape *sh)
+{
+    free(sh->pos);
+    free(sh->uv);
+    free(sh->nrm);
+    free(sh->idx);
+}
+
+static int load_shapes(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    if (!n)
+        return 0;
+    if (n->kind != MURK_Y_SEQ)
+        return ERR(n, "shapes must be a list");
+    s->shapes = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->shapes);
+    for (size_t i = 0; i < n->n; i++) {
+        murk_shape *sh = &s->shapes[i];
+        sh->light_base = -1;
+        if (load_shape(s, n->items[i], sh, err, errlen)) {
+            shape_free(sh);
+            memset(sh, 0, sizeof *sh);
+            return -1;
+        }
+        s->nshapes++;
+    }
+    return 0;
+}
+
+/* Media are loaded by media.c once density fields exist; until then a scene with media is refused. */
+int murk_scene_load_media(murk_scene *s, const murk_ynode *n, char *err, size_t errlen) __attribute__((weak));
+
+static int load_document(murk_scene *s, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
+                                       "materials", "media", "shapes"};
+    const murk_ynode *root = s->doc.root;
+    if (!root)
+        return murk_yerr(err, errlen, &(murk_ynode){.file = s->doc.file, .line = 1, .col = 1},
+                         "empty scene (expected a map with at least 'murk: 1' and 'shapes')");
+    if (expect_map(root, "a scene", err, errlen) || check_keys(root, "the scene", keys, NKEYS(keys), err, errlen))
+        return -1;
+    const murk_ynode *v = require(root, "murk", "the scene", err, errlen);
+    long long ver;
+    if (!v || read_int(v, "murk (the format version)", 1, 1, &ver, err, errlen))
+        return -1;
+    const murk_ynode *c;
+    if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
+        return -1;
+    double bg[3] = {0, 0, 0};
+    if ((c = murk_ymap_get(root, "background")) && read_rgb(c, "background", 0, 1e30, bg, err, errlen))
+        return -1;
+    s->background = to_rgb(bg);
+    if ((c = murk_ymap_get(root, "media"))) {
+        if (!murk_scene_load_media)
+            return ERR(c, "media are not supported by this build of murk");
+        if (murk_scene_load_media(s, c, err, errlen))
+            return -1;
+    }
+    if (load_camera(s, murk_ymap_get(root, "camera"), err, errlen))
+        return -1;
+    if (load_materials(s, murk_ymap_get(root, "materials"), err, errlen))
+        return -1;
+    if (load_integrator(s, murk_ymap_get(root, "integrator"), err, errlen))
+        return -1;
+    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen))
+        return -1;
+    return 0;
+}
+
+MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen)
+{
+    murk_scene *s = murk_xmalloc(sizeof *s);
+    murk_registry_init(&s->reg);
+    if (murk_ydoc_load_file(&s->doc, path, err, errlen) != 0) {
+        murk_scene_free(s);
+        return NULL;
+    }
+    for (size_t i = 0; i < nsets; i++)
+        if (murk_ydoc_set(&s->doc, sets[i], err, errlen) != 0) {
+            murk_scene_free(s);
+            return NULL;
+        }
+    if (load_document(s, err, errlen) != 0 || murk_accel_build(s, err, errlen) != 0) {
+        murk_scene_free(s);
+        return NULL;
+    }
+    murk_lights_build(s);
+    return s;
+}
+
+void murk_scene_free_media(murk_scene *s) __attribute__((weak));
+
+MURK_API void murk_scene_free(murk_scene *s)
+{
+    if (!s)
+        return;
+    if (s->rtc)
+        rtcReleaseScene(s->rtc);
+    if (s->device)
+        rtcReleaseDevice(s->device);
+    if (s->integrator && s->integrator_vt)
+        s->integrator_vt->destroy(s->integrator);
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        s->materials[i].m.vt->destroy(s->materials[i].m.self);
+        free(s->materials[i].name);
+    }
+    free(s->materials);
+    if (murk_scene_free_media)
+        murk_scene_free_media(s);
+    for (size_t i = 0; i < s->nshapes; i++)
+        shape_free(&s->shapes[i]);
+    free(s->shapes);
+    for (size_t i = 0; i < s->ntextures; i++)
+        murk_texture_free(s->textures[i]);
+    free(s->textures);
+    for (size_t i = 0; i < s->nparam_store; i++)
+        free(s->param_store[i]);
+    free(s->param_store);
+    free(s->lights);
+    free(s->light_cdf);
+    murk_registry_free(&s->reg);
+    murk_ydoc_free(&s->doc);
+    free(s);
+}

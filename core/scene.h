@@ -1,0 +1,96 @@
+/* scene.h — the scene as the core holds it after loading and validation. Internal to libmurk. */
+#ifndef MURK_SCENE_H
+#define MURK_SCENE_H
+
+#include <embree3/rtcore.h>
+
+#include "murk/integrator.h"
+#include "murk/material.h"
+#include "murk/medium.h"
+#include "murk/murk.h"
+#include "plugin_loader.h"
+#include "yamldoc.h"
+
+typedef enum { MURK_SHAPE_QUAD, MURK_SHAPE_SPHERE, MURK_SHAPE_BOX, MURK_SHAPE_MESH } murk_shape_type;
+
+typedef struct murk_shape {
+    murk_shape_type type;
+    const murk_material *material;             /* NULL: medium boundary only */
+    const murk_medium *interior, *exterior;
+    murk_rgb emission;
+    int32_t light_base;                        /* light index of primitive 0, or -1 */
+    uint32_t nverts, ntris;
+    float *pos;                                /* 3*nverts (triangle shapes) */
+    float *uv;                                 /* 2*nverts or NULL */
+    float *nrm;                                /* 3*nverts or NULL (mesh shading normals) */
+    uint32_t *idx;                             /* 3*ntris */
+    murk_vec3 center;                          /* sphere */
+    float radius;
+} murk_shape;
+
+typedef struct murk_light {
+    uint32_t geom, prim;
+    int sphere;
+    murk_vec3 p0, e1, e2, n; /* triangle: p0 + a e1 + b e2; unit normal (emitting side) */
+    murk_vec3 center;        /* sphere */
+    float radius, area;
+    float pmf; /* probability of picking this light */
+    murk_rgb le;
+} murk_light;
+
+typedef struct murk_named_material { char *name; murk_material m; const murk_plugin *plugin; } murk_named_material;
+
+typedef struct murk_named_medium {
+    char *name;
+    murk_medium m;
+    murk_medium_data data;
+    const murk_plugin *plugin;
+    struct murk_density *density; /* owned */
+} murk_named_medium;
+
+struct murk_texture;
+
+struct murk_scene {
+    murk_ydoc doc;
+    murk_registry reg;
+    /* render block */
+    int width, height, spp;
+    uint64_t seed;
+    float exposure;
+    /* camera */
+    murk_vec3 cam_from, cam_at, cam_up;
+    float fov;
+    murk_vec3 cam_w, cam_u, cam_v; /* forward, right, up (unit) */
+    float cam_tan;                 /* tan(fov/2) */
+    const murk_medium *camera_medium;
+    murk_rgb background;
+    /* plugins and their instances */
+    murk_named_material *materials;
+    size_t nmaterials;
+    murk_named_medium *media;
+    size_t nmedia;
+    const murk_plugin *integrator_plugin;
+    void *integrator;
+    const murk_integrator_vt *integrator_vt;
+    murk_value **param_store; /* parameter arrays handed to create(), freed with the scene */
+    size_t nparam_store;
+    struct murk_texture **textures;
+    size_t ntextures;
+    /* geometry */
+    murk_shape *shapes; /* index = Embree geometry id */
+    size_t nshapes;
+    murk_light *lights;
+    size_t nlights;
+    float *light_cdf; /* nlights + 1 */
+    float light_power;
+    RTCDevice device;
+    RTCScene rtc;
+};
+
+
+/* accel.c */
+int murk_accel_build(murk_scene *s, char *err, size_t errlen);
+/* lights.c */
+void murk_lights_build(murk_scene *s);
+
+#endif

@@ -1,0 +1,122 @@
+/* util.c — small helpers internal to libmurk. */
+#include "util.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static int quiet;
+
+void *murk_xmalloc(size_t n)
+{
+    void *p = calloc(1, n ? n : 1);
+    if (!p) {
+        fprintf(stderr, "murk: out of memory (%zu bytes)\n", n);
+        exit(2);
+    }
+    return p;
+}
+
+void *murk_xrealloc(void *p, size_t n)
+{
+    void *q = realloc(p, n ? n : 1);
+    if (!q) {
+        fprintf(stderr, "murk: out of memory (%zu bytes)\n", n);
+        exit(2);
+    }
+    return q;
+}
+
+char *murk_strdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = murk_xmalloc(n);
+    memcpy(d, s, n);
+    return d;
+}
+
+int murk_snprintf(char *buf, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int r = vsnprintf(buf, n, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
+int murk_edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    if (la > 63 || lb > 63)
+        return 64;
+    int d[64][64];
+    for (size_t i = 0; i <= la; i++)
+        d[i][0] = (int)i;
+    for (size_t j = 0; j <= lb; j++)
+        d[0][j] = (int)j;
+    for (size_t i = 1; i <= la; i++)
+        for (size_t j = 1; j <= lb; j++) {
+            int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < c)
+                c = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < c)
+                c = d[i][j - 1] + 1;
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < c)
+                c = d[i - 2][j - 2] + 1; /* transposition */
+            d[i][j] = c;
+        }
+    return d[la][lb];
+}
+
+const char *murk_did_you_mean(const char *word, const char *const *candidates, size_t n)
+{
+    const char *best = NULL;
+    int bestd = 1 << 30;
+    for (size_t i = 0; i < n; i++) {
+        int dist = murk_edit_distance(word, candidates[i]);
+        if (dist < bestd) {
+            bestd = dist;
+            best = candidates[i];
+        }
+    }
+    size_t len = strlen(word);
+    int limit = len <= 3 ? 1 : (len <= 6 ? 2 : 3);
+    return best && bestd <= limit ? best : NULL;
+}
+
+char *murk_path_relative_to(const char *path, const char *rel)
+{
+    if (rel[0] == '/' || !path)
+        return murk_strdup(rel);
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        return murk_strdup(rel);
+    size_t dl = (size_t)(slash - path) + 1, rl = strlen(rel);
+    char *out = murk_xmalloc(dl + rl + 1);
+    memcpy(out, path, dl);
+    memcpy(out + dl, rel, rl + 1);
+    return out;
+}
+
+double murk_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void murk_set_quiet(int q) { quiet = q; }
+
+void murk_log(int level, const char *fmt, ...)
+{
+    if (quiet && level == MURK_LOG_INFO)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fputs(level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}

@@ -1,0 +1,25 @@
+/* util.h — small helpers internal to libmurk: error formatting, strings, did-you-mean, paths. */
+#ifndef MURK_UTIL_H
+#define MURK_UTIL_H
+
+#include <stddef.h>
+#include "murk/plugin.h"
+
+/* Visible from libmurk (the embedding API and what the murk command needs). */
+#define MURK_API __attribute__((visibility("default")))
+
+void *murk_xmalloc(size_t n);           /* zeroed; aborts with a message when out of memory */
+void *murk_xrealloc(void *p, size_t n);
+char *murk_strdup(const char *s);
+int murk_snprintf(char *buf, size_t n, const char *fmt, ...) MURK_PRINTF(3, 4);
+/* Levenshtein distance, capped at 64 for long strings. */
+int murk_edit_distance(const char *a, const char *b);
+/* The candidate closest to `word` when close enough to be a plausible typo, else NULL. */
+const char *murk_did_you_mean(const char *word, const char *const *candidates, size_t n);
+/* dir of `path` joined with rel (rel returned as-is when absolute); malloc'd. */
+char *murk_path_relative_to(const char *path, const char *rel);
+double murk_now(void); /* monotonic seconds */
+void murk_log(int level, const char *fmt, ...) MURK_PRINTF(2, 3);
+void murk_set_quiet(int quiet);
+
+#endif

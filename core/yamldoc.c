@@ -1,0 +1,407 @@
+/* yamldoc.c — libyaml events to a located tree; --set overrides. */
+#include "yamldoc.h"
+#include "util.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+murk_ynode *murk_ynode_new(murk_ykind kind, const char *file, int line, int col)
+{
+    murk_ynode *n = murk_xmalloc(sizeof *n);
+    n->kind = kind;
+    n->file = file;
+    n->line = line;
+    n->col = col;
+    return n;
+}
+
+void murk_ynode_free(murk_ynode *n)
+{
+    if (!n)
+        return;
+    for (size_t i = 0; i < n->n; i++) {
+        murk_ynode_free(n->items[i]);
+        if (n->keys)
+            free(n->keys[i]);
+    }
+    free(n->items);
+    free(n->keys);
+    free(n->key_line);
+    free(n->key_col);
+    free(n->str);
+    free(n);
+}
+
+static void append(murk_ynode *parent, murk_ynode *child, char *key, int kl, int kc)
+{
+    size_t n = parent->n + 1;
+    parent->items = murk_xrealloc(parent->items, n * sizeof *parent->items);
+    parent->items[n - 1] = child;
+    if (parent->kind == MURK_Y_MAP) {
+        parent->keys = murk_xrealloc(parent->keys, n * sizeof *parent->keys);
+        parent->key_line = murk_xrealloc(parent->key_line, n * sizeof(int));
+        parent->key_col = murk_xrealloc(parent->key_col, n * sizeof(int));
+        parent->keys[n - 1] = key;
+        parent->key_line[n - 1] = kl;
+        parent->key_col[n - 1] = kc;
+    }
+    parent->n = n;
+}
+
+murk_ynode *murk_ymap_get(const murk_ynode *map, const char *key)
+{
+    if (!map || map->kind != MURK_Y_MAP)
+        return NULL;
+    for (size_t i = 0; i < map->n; i++)
+        if (strcmp(map->keys[i], key) == 0)
+            return map->items[i];
+    return NULL;
+}
+
+static int verr(char *err, size_t errlen, const char *file, int line, int col, const char *fmt, va_list ap)
+{
+    int k = snprintf(err, errlen, "%s:%d:%d: ", file, line, col);
+    if (k >= 0 && (size_t)k < errlen)
+        vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
+    return -1;
+}
+
+int murk_yerr(char *err, size_t errlen, const murk_ynode *n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    verr(err, errlen, n->file, n->line, n->col, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+int murk_yerr_key(char *err, size_t errlen, const murk_ynode *map, size_t i, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    verr(err, errlen, map->file, map->key_line[i], map->key_col[i], fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* Builds the tree from the parser's events. Depth is bounded so hostile input can't blow the stack. */
+enum { MAX_DEPTH = 64 };
+
+static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t textlen, const char *file,
+                        murk_ynode **root, char *err, size_t errlen)
+{
+    murk_ynode *stack[MAX_DEPTH];
+    char *pending_key[MAX_DEPTH];
+    int pk_line[MAX_DEPTH], pk_col[MAX_DEPTH];
+    int depth = 0, docs = 0, rc = 0;
+    *root = NULL;
+    for (;;) {
+        yaml_event_t ev;
+        if (!yaml_parser_parse(p, &ev)) {
+            int line = (int)p->problem_mark.line + 1, col = (int)p->problem_mark.column + 1;
+            const char *prob = p->problem ? p->problem : "malformed YAML";
+            if (p->problem_mark.index < textlen && text[p->problem_mark.index] == '\t') {
+                /* libyaml says this of a tab used for indentation: say so plainly. */
+                prob = "tab character: YAML indentation must use spaces";
+            }
+            if (p->context)
+                snprintf(err, errlen, "%s:%d:%d: %s %s", file, line, col, prob, p->context);
+            else
+                snprintf(err, errlen, "%s:%d:%d: %s", file, line, col, prob);
+            rc = -1;
+            break;
+        }
+        int line = (int)ev.start_mark.line + 1, col = (int)ev.start_mark.column + 1;
+        murk_ynode *node = NULL;
+        int done = 0;
+        switch (ev.type) {
+        case YAML_STREAM_END_EVENT:
+            done = 1;
+            break;
+        case YAML_DOCUMENT_START_EVENT:
+            if (++docs > 1) {
+                snprintf(err, errlen, "%s:%d:%d: a scene file holds one YAML document", file, line, col);
+                rc = -1;
+                done = 1;
+            }
+            break;
+        case YAML_ALIAS_EVENT:
+            snprintf(err, errlen, "%s:%d:%d: YAML aliases are not supported in scenes", file, line, col);
+            rc = -1;
+            done = 1;
+            break;
+        case YAML_SCALAR_EVENT:
+            node = murk_ynode_new(MURK_Y_SCALAR, file, line, col);
+            node->str = murk_strdup((const char *)ev.data.scalar.value);
+            node->plain = ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE;
+            break;
+        case YAML_SEQUENCE_START_EVENT:
+        case YAML_MAPPING_START_EVENT:
+            node = murk_ynode_new(ev.type == YAML_SEQUENCE_START_EVENT ? MURK_Y_SEQ : MURK_Y_MAP, file, line, col);
+            break;
+        case YAML_SEQUENCE_END_EVENT:
+        case YAML_MAPPING_END_EVENT: {
+            murk_ynode *top = stack[--depth];
+            if (depth == 0) {
+                *root = top;
+            } else {
+                murk_ynode *parent = stack[depth - 1];
+                append(parent, top, pending_key[depth - 1], pk_line[depth - 1], pk_col[depth - 1]);
+                pending_key[depth - 1] = NULL;
+            }
+            break;
+        }
+        default:
+            break;
+        }
+        if (node) {
+            int container = node->kind != MURK_Y_SCALAR;
+            if (depth == 0) {
+                if (container) {
+                    stack[depth++] = node;
+                    pending_key[0] = NULL;
+                } else {
+                    *root = node;
+                }
+            } else {
+                murk_ynode *parent = stack[depth - 1];
+                if (parent->kind == MURK_Y_MAP && !pending_key[depth - 1]) {
+                    /* this node is a key */
+                    if (container) {
+                        snprintf(err, errlen, "%s:%d:%d: a map key must be a plain name", file, line, col);
+                        murk_ynode_free(node);
+                        rc = -1;
+                        done = 1;
+                    } else {
+                        if (murk_ymap_get(parent, node->str)) {
+                            snprintf(err, errlen, "%s:%d:%d: duplicate key '%s'", file, line, col, node->str);
+                            murk_ynode_free(node);
+                            rc = -1;
+                            done = 1;
+                        } else {
+                            pending_key[depth - 1] = node->str;
+                            pk_line[depth - 1] = node->line;
+                            pk_col[depth - 1] = node->col;
+                            node->str = NULL;
+                            murk_ynode_free(node);
+                        }
+                    }
+                } else if (container) {
+                    if (depth >= MAX_DEPTH) {
+                        snprintf(err, errlen, "%s:%d:%d: nesting deeper than %d levels", file, line, col, MAX_DEPTH);
+                        murk_ynode_free(node);
+                        rc = -1;
+                        done = 1;
+                    } else {
+                        stack[depth] = node;
+                        pending_key[depth] = NULL;
+                        depth++;
+                    }
+                } else if (parent->kind == MURK_Y_MAP) {
+                    append(parent, node, pending_key[depth - 1], pk_line[depth - 1], pk_col[depth - 1]);
+                    pending_key[depth - 1] = NULL;
+                } else {
+                    append(parent, node, NULL, 0, 0);
+                }
+            }
+        }
+        yaml_event_delete(&ev);
+        if (done)
+            break;
+    }
+    if (rc != 0) {
+        /* free whatever is still open: each open container is owned only by the stack */
+        for (int i = depth - 1; i >= 0; i--) {
+            free(pending_key[i]);
+            murk_ynode_free(stack[i]);
+        }
+        if (depth == 0 && *root) {
+            murk_ynode_free(*root);
+        }
+        *root = NULL;
+    }
+    return rc;
+}
+
+static int load(murk_ydoc *doc, const unsigned char *text, size_t len, const char *name, char *err, size_t errlen)
+{
+    memset(doc, 0, sizeof *doc);
+    doc->file = murk_strdup(name);
+    yaml_parser_t p;
+    if (!yaml_parser_initialize(&p)) {
+        snprintf(err, errlen, "%s: cannot initialise the YAML parser", name);
+        return -1;
+    }
+    yaml_parser_set_input_string(&p, text, len);
+    int rc = parse_events(&p, text, len, doc->file, &doc->root, err, errlen);
+    yaml_parser_delete(&p);
+    if (rc != 0) {
+        free(doc->file);
+        doc->file = NULL;
+    }
+    return rc;
+}
+
+int murk_ydoc_load_string(murk_ydoc *doc, const char *text, const char *name, char *err, size_t errlen)
+{
+    return load(doc, (const unsigned char *)text, strlen(text), name, err, errlen);
+}
+
+int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errlen)
+{
+    memset(doc, 0, sizeof *doc);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    size_t cap = 1 << 16, n = 0;
+    unsigned char *buf = murk_xmalloc(cap);
+    for (;;) {
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (n < cap)
+            break;
+        if (cap >= ((size_t)64 << 20)) {
+            fclose(f);
+            free(buf);
+            snprintf(err, errlen, "%s: scene file larger than 64 MiB", path);
+            return -1;
+        }
+        buf = murk_xrealloc(buf, cap *= 2);
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        snprintf(err, errlen, "%s: read error", path);
+        return -1;
+    }
+    if (memchr(buf, 0, n)) {
+        free(buf);
+        snprintf(err, errlen, "%s:1:1: not a text file (contains NUL bytes)", path);
+        return -1;
+    }
+    int rc = load(doc, buf, n, path, err, errlen);
+    free(buf);
+    return rc;
+}
+
+void murk_ydoc_free(murk_ydoc *doc)
+{
+    murk_ynode_free(doc->root);
+    free(doc->file);
+    memset(doc, 0, sizeof *doc);
+}
+
+static void retag(murk_ynode *n, const char *file, int col_offset)
+{
+    n->file = file;
+    n->col += col_offset;
+    for (size_t i = 0; i < n->n; i++) {
+        retag(n->items[i], file, col_offset);
+        if (n->key_col)
+            n->key_col[i] += col_offset;
+    }
+}
+
+static int is_index(const char *s)
+{
+    if (!*s)
+        return 0;
+    for (; *s; s++)
+        if (*s < '0' || *s > '9')
+            return 0;
+    return 1;
+}
+
+int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errlen)
+{
+    static const char *const SETFILE = "--set";
+    const char *eq = strchr(assignment, '=');
+    if (!eq || eq == assignment) {
+        snprintf(err, errlen, "--set:1:1: expected KEY.PATH=VALUE, got '%s'", assignment);
+        return -1;
+    }
+    int value_col = (int)(eq - assignment) + 2;
+    murk_ydoc vdoc;
+    char verrbuf[512];
+    if (murk_ydoc_load_string(&vdoc, eq + 1, SETFILE, verrbuf, sizeof verrbuf) != 0) {
+        /* shift the column to the position inside the whole argument */
+        int l = 1, c = 1;
+        if (sscanf(verrbuf, "--set:%d:%d:", &l, &c) == 2) {
+            const char *msg = strchr(strchr(strchr(verrbuf, ':') + 1, ':') + 1, ':') + 1;
+            snprintf(err, errlen, "--set:1:%d:%s", c + value_col - 1, msg);
+        } else {
+            snprintf(err, errlen, "%s", verrbuf);
+        }
+        return -1;
+    }
+    murk_ynode *value = vdoc.root;
+    vdoc.root = NULL;
+    free(vdoc.file);
+    if (!value) {
+        value = murk_ynode_new(MURK_Y_SCALAR, SETFILE, 1, 1);
+        value->str = murk_strdup("");
+        value->plain = 1;
+    }
+    retag(value, SETFILE, value_col - 1);
+
+    if (!doc->root)
+        doc->root = murk_ynode_new(MURK_Y_MAP, SETFILE, 1, 1);
+    murk_ynode *cur = doc->root;
+    const char *seg = assignment;
+    for (;;) {
+        const char *dot = memchr(seg, '.', (size_t)(eq - seg));
+        const char *end = dot ? dot : eq;
+        size_t len = (size_t)(end - seg);
+        int col = (int)(seg - assignment) + 1;
+        char *key = murk_xmalloc(len + 1);
+        memcpy(key, seg, len);
+        if (len == 0) {
+            free(key);
+            murk_ynode_free(value);
+            snprintf(err, errlen, "--set:1:%d: empty key in '%.*s'", col, (int)(eq - assignment), assignment);
+            return -1;
+        }
+        murk_ynode **slot = NULL;
+        if (cur->kind == MURK_Y_SEQ) {
+            if (!is_index(key) || strtoul(key, NULL, 10) >= cur->n) {
+                snprintf(err, errlen, "--set:1:%d: '%s' is not an index of this list (it has %zu items)", col, key,
+                         cur->n);
+                free(key);
+                murk_ynode_free(value);
+                return -1;
+            }
+            slot = &cur->items[strtoul(key, NULL, 10)];
+            free(key);
+        } else if (cur->kind == MURK_Y_MAP) {
+            for (size_t i = 0; i < cur->n; i++)
+                if (strcmp(cur->keys[i], key) == 0)
+                    slot = &cur->items[i];
+            if (!slot) {
+                murk_ynode *fresh = murk_ynode_new(dot ? MURK_Y_MAP : MURK_Y_SCALAR, SETFILE, 1, col);
+                append(cur, fresh, key, 1, col);
+                slot = &cur->items[cur->n - 1];
+            } else {
+                free(key);
+            }
+        } else {
+            snprintf(err, errlen, "--set:1:%d: cannot descend into a scalar at '%s'", col, key);
+            free(key);
+            murk_ynode_free(value);
+            return -1;
+        }
+        if (!dot) {
+            murk_ynode_free(*slot);
+            *slot = value;
+            return 0;
+        }
+        cur = *slot;
+        seg = dot + 1;
+    }
+}

@@ -1,0 +1,26 @@
+#!/bin/sh
+# Installs whatever Debian packages murk needs and are missing, then configures and builds murk in
+# ./build (or $MURK_BUILD_DIR). Safe to run again: it only does what is not done yet.
+set -eu
+cd "$(dirname "$0")/.."
+BUILD=${MURK_BUILD_DIR:-build}
+
+# Build, test and data dependencies, all from Debian 12's own archive.
+PKGS="gcc meson ninja-build pkg-config cmake libembree-dev libopenexr-dev libyaml-dev libpng-dev
+      libcmocka-dev libnanovdb-dev glmark2-data"
+missing=""
+for p in $PKGS; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "murk: installing Debian packages:$missing"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
+fi
+
+if [ ! -f "$BUILD/build.ninja" ]; then
+  meson setup "$BUILD" --buildtype=release
+fi
+ninja -C "$BUILD"
