@@ -5,6 +5,7 @@
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
 #include "host.h"
 #include "image.h"
+#include "media.h"
 #include "plugin_loader.h"
 #include "scene.h"
 #include "util.h"
@@ -180,6 +181,7 @@ static int cmd_render(int argc, char **argv)
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
     }
+    murk_warn_summary();
     if (res.nonfinite)
         murk_log(MURK_LOG_WARN, "%llu samples were NaN or infinite and were left out of their pixels",
                  (unsigned long long)res.nonfinite);

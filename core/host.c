@@ -2,6 +2,7 @@
  * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays are counted
  * per thread for the rays/s figure. */
 #include "host.h"
+#include "media.h"
 #include "scene.h"
 #include "texture.h"
 #include "util.h"
@@ -227,6 +228,12 @@ static const murk_host host_table = {
     .light_pdf = host_light_pdf,
     .background = host_background,
     .camera_medium = host_camera_medium,
+    .density = murk_media_density,
+    .walk_init = murk_media_walk_init,
+    .walk_next = murk_media_walk_next,
+    .warn_once = murk_warn_once,
+    .phase_eval = murk_phase_hg_eval,
+    .phase_sample = murk_phase_hg_sample,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }

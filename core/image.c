@@ -312,8 +312,8 @@ static exr_result_t exr_write_file(exr_io *io, const char *tmp, const float *rgb
         if (rv == EXR_ERR_SUCCESS)
             rv = exr_attr_set_string(ctx, part, meta[i].key, meta[i].value ? meta[i].value : "");
     }
-    *what = NULL;
     if (rv == EXR_ERR_SUCCESS) {
+        *what = NULL;
         *step = "writing the header";
         rv = exr_write_header(ctx);
     }
@@ -347,7 +347,7 @@ int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_
     if (rv != EXR_ERR_SUCCESS) {
         const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
         if (what)
-            fail(err, errlen, "%s: EXR error %s '%s': %s", path, step, what, why);
+            fail(err, errlen, "%s: EXR error %s '%.64s': %s", path, step, what, why);
         else
             fail(err, errlen, "%s: EXR error %s: %s", path, step, why);
         close(io.fd);

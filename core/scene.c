@@ -5,6 +5,7 @@
  * the scene names are loaded. */
 #include "scene.h"
 #include "host.h"
+#include "media.h"
 #include "obj.h"
 #include "texture.h"
 #include "util.h"
@@ -158,7 +159,7 @@ static const murk_ynode *require(const murk_ynode *map, const char *key, const c
 
 /* ---- Plugin parameters ----------------------------------------------------------------------- */
 
-static murk_value *keep_params(murk_scene *s, size_t n)
+murk_value *murk_scene_keep_params(murk_scene *s, size_t n)
 {
     murk_value *v = murk_xmalloc((n ? n : 1) * sizeof *v);
     s->param_store = murk_xrealloc(s->param_store, (s->nparam_store + 1) * sizeof *s->param_store);
@@ -183,8 +184,8 @@ static int choice_index(const char *choices, const char *word)
 
 /* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
  * block in messages, e.g. "material 'metal' (ggx)". */
-static int read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
-                              const char *const *skip, size_t nskip, murk_value *values, char *err, size_t errlen)
+int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
+                                  const char *const *skip, size_t nskip, murk_value *values, char *err, size_t errlen)
 {
     for (uint32_t i = 0; i < d->nparams; i++) {
         const murk_param *p = &d->params[i];
@@ -416,8 +417,8 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
             return ERR(t, "%s: %s", who, lerr);
         snprintf(who, sizeof who, "material '%s' (%s)", n->keys[i], type);
         static const char *const skip[] = {"type"};
-        murk_value *vals = keep_params(s, p->desc->nparams);
-        if (read_plugin_params(s, p->desc, m, who, skip, 1, vals, err, errlen))
+        murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
+        if (murk_scene_read_plugin_params(s, p->desc, m, who, skip, 1, vals, err, errlen))
             return -1;
         murk_named_material *nm = &s->materials[s->nmaterials];
         const murk_material_vt *vt = p->desc->vtable;
@@ -456,8 +457,8 @@ static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t
         return ERR(t ? t : n, "integrator: %s", lerr);
     }
     snprintf(who, sizeof who, "integrator '%s'", type);
-    murk_value *vals = keep_params(s, p->desc->nparams);
-    if (read_plugin_params(s, p->desc, n, who, skip, 1, vals, err, errlen))
+    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
+    if (murk_scene_read_plugin_params(s, p->desc, n, who, skip, 1, vals, err, errlen))
         return -1;
     const murk_integrator_vt *vt = p->desc->vtable;
     char cerr[512] = "";
@@ -720,9 +721,6 @@ static int load_shapes(murk_scene *s, const murk_ynode *n, char *err, size_t err
     return 0;
 }
 
-/* Media are loaded by media.c once density fields exist; until then a scene with media is refused. */
-int murk_scene_load_media(murk_scene *s, const murk_ynode *n, char *err, size_t errlen) __attribute__((weak));
-
 static int load_document(murk_scene *s, char *err, size_t errlen)
 {
     static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
@@ -745,9 +743,7 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     s->background = to_rgb(bg);
     if ((c = murk_ymap_get(root, "media"))) {
-        if (!murk_scene_load_media)
-            return ERR(c, "media are not supported by this build of murk");
-        if (murk_scene_load_media(s, c, err, errlen))
+        if (murk_media_load(s, c, err, errlen))
             return -1;
     }
     if (load_camera(s, murk_ymap_get(root, "camera"), err, errlen))
@@ -782,8 +778,6 @@ MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, 
     return s;
 }
 
-void murk_scene_free_media(murk_scene *s) __attribute__((weak));
-
 MURK_API void murk_scene_free(murk_scene *s)
 {
     if (!s)
@@ -799,8 +793,7 @@ MURK_API void murk_scene_free(murk_scene *s)
         free(s->materials[i].name);
     }
     free(s->materials);
-    if (murk_scene_free_media)
-        murk_scene_free_media(s);
+    murk_media_free(s);
     for (size_t i = 0; i < s->nshapes; i++)
         shape_free(&s->shapes[i]);
     free(s->shapes);

@@ -88,6 +88,13 @@ struct murk_scene {
 };
 
 
+/* Shared by the blocks that instantiate plugins (scene.c, media.c): parameter arrays kept for the
+ * scene's lifetime, and schema-checked reading of a plugin block's keys (those in skip[] excepted). */
+murk_value *murk_scene_keep_params(murk_scene *s, size_t n);
+int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
+                                  const char *const *skip, size_t nskip, murk_value *values, char *err,
+                                  size_t errlen);
+
 /* accel.c */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 /* lights.c */

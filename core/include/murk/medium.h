@@ -2,17 +2,28 @@
  *
  * The core owns a medium's data — density field, sigma_a, sigma_s, phase function, majorant and
  * minorant grids — and hands a tracker plugin a murk_medium_data at create(); the plugin owns only its
- * method (delta, decomposition, spectral, ...) and its own parameters.
+ * method (delta, decomposition, spectral, ...) and its own parameters. Trackers reach the density and
+ * the majorant grid through murk_host's density services (density, walk_init, walk_next, warn_once).
  *
- * sample() tracks a free flight along ray->d over (ray->tmin, ray->tmax) and reports either a real
- * scattering event at ev->t or that the flight left the segment. It returns its result as two RGB
- * factors that the integrator multiplies into the path: ev->weight (the contribution f, per channel)
- * and ev->pdf (per-channel path-pdf ratios used by spectral MIS; (1,1,1) for every other tracker). An
- * integrator computes a path's value as  prod(weight) * L / mean_c(prod(pdf)_c) , which reduces to the
- * usual throughput when pdf is 1. Trackers are unbiased for any bounding majorant: the expected value of
- * every estimate must not depend on the tracker, the majorant or the tracker's own parameters.
- * transmittance() returns an unbiased per-channel estimate of exp(-int sigma_t) along the segment
- * (ratio tracking or similar), used on shadow rays. */
+ * Path weights. An integrator keeps, per path, an RGB weight beta and RGB pdf ratios R (both start at
+ * 1) and credits a path's emitted radiance L as  beta_c * L_c / mean_k(R_k) . A tracker returns, for
+ * each free flight it samples, the factors to multiply in:
+ *   ev->weight = f / p_hero   per channel: the flight's contribution over the pdf it was sampled with
+ *                             (for plain delta tracking: 1 through to the surface, the albedo at a
+ *                             scattering event; 0 means the path was absorbed)
+ *   ev->pdf    = p_k / p_hero per channel: the pdf channel k's own technique would have given this
+ *                             flight, relative to the one used. (1,1,1) for every tracker except the
+ *                             per-channel ones (spectral_mis: the balance heuristic over channels;
+ *                             naive_spectral: 1 for the path's hero channel, 0 for others, so the
+ *                             hero channel alone gets 3x its estimate).
+ * The hero channel is chosen once per path by the integrator (uniformly) and passed in ctx.
+ * Every tracker is unbiased for any bounding majorant: the expected image must not depend on the
+ * tracker, the majorant or the tracker's parameters. Where a bound fails (majorant below the density,
+ * control above it) a tracker must stay unbiased (e.g. by weighted collisions), stay finite, and say so
+ * once through host->warn_once.
+ *
+ * transmittance() returns an unbiased per-channel estimate of exp(-int sigma_t) over the segment
+ * (ratio tracking or better), used on shadow rays. */
 #ifndef MURK_MEDIUM_H
 #define MURK_MEDIUM_H
 
@@ -20,40 +31,48 @@
 
 typedef struct murk_density murk_density; /* opaque: a density field with its majorant/minorant grid */
 
-/* What the core gives every tracker at create() (passed to create()). */
+/* What the core gives every tracker at create(). Coefficients are per unit density, with the scene's
+ * `scale` applied: sigma_t(x) = density(x) * (sigma_a + sigma_s). */
 typedef struct murk_medium_data {
     uint32_t size;
-    murk_rgb sigma_a, sigma_s;    /* per unit density, scene `scale` already applied */
+    murk_rgb sigma_a, sigma_s;
     float g;                      /* Henyey-Greenstein asymmetry of the phase function */
     float majorant_factor;        /* multiplies the majorant grid (>= 1 keeps it bounding) */
+    float density_max, density_min; /* over the whole field (min over its box; 0 outside it) */
     const murk_density *density;
     const char *name;             /* the medium's name in the scene, for messages */
 } murk_medium_data;
 
-/* A walk over the majorant grid along a ray: consecutive segments [ta, tb) with the maximum and
- * minimum density over each (already multiplied by majorant_factor for the maximum). Opaque storage. */
-typedef struct murk_dda { uint64_t opaque[24]; } murk_dda;
+/* A walk over the majorant grid along a ray: consecutive segments [ta, tb) that tile the range given
+ * to walk_init exactly, each with the maximum density over it (already multiplied by
+ * majorant_factor) and the minimum density. Parts outside the field's box come out with max = min = 0.
+ * Opaque storage on the caller's stack. */
+typedef struct murk_majorant_walk { uint64_t opaque[32]; } murk_majorant_walk;
 
 typedef struct murk_medium_event {
-    int scattered;   /* 1: a real scattering event at t; 0: the flight passed tmax */
+    int scattered;   /* 1: a real scattering event at t; 0: the flight passed the segment's end */
     float t;
-    murk_rgb weight; /* multiply into the path's contribution */
-    murk_rgb pdf;    /* multiply into the path's per-channel pdf ratios (spectral MIS), else (1,1,1) */
+    murk_rgb weight; /* multiply into the path's beta (all 0: absorbed, the path ends) */
+    murk_rgb pdf;    /* multiply into the path's pdf ratios R; (1,1,1) for non-spectral-MIS trackers */
 } murk_medium_event;
 
-/* Per-path state an integrator passes to trackers (spectral MIS's hero channel). */
+/* Per-path state an integrator passes to trackers. */
 typedef struct murk_path_ctx {
-    int hero; /* channel 0..2 this path samples with (spectral_mis); others may ignore it */
+    int hero;        /* channel 0..2 chosen uniformly per path */
+    murk_rgb beta;   /* the path's weight so far (history-aware probabilities use it) */
 } murk_path_ctx;
 
 typedef struct murk_medium_vt {
     uint32_t size; /* sizeof(murk_medium_vt) of the plugin */
-    /* create() gets its own parameters in `params`; the core's data for the medium in `data`. */
+    /* create() gets its own parameters in `params` and the core's data for the medium in `data`
+     * (valid for the medium's whole life). */
     int (*create)(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
                   char *err, size_t errlen);
     void (*destroy)(void *self);
+    /* Samples a free flight along ray->d from ray->o over (ray->tmin, ray->tmax). */
     int (*sample)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                   murk_medium_event *ev);
+    /* Unbiased per-channel transmittance estimate over (ray->tmin, ray->tmax). */
     murk_rgb (*transmittance)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng);
 } murk_medium_vt;
 

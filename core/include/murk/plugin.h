@@ -75,6 +75,8 @@ typedef struct murk_value {
 typedef struct murk_material murk_material; /* a material instance (see murk/material.h) */
 typedef struct murk_medium murk_medium;     /* a medium instance (see murk/medium.h) */
 typedef struct murk_scene murk_scene;       /* opaque scene handle given to integrators */
+typedef struct murk_density murk_density;   /* a medium's density field (see murk/medium.h) */
+typedef struct murk_majorant_walk murk_majorant_walk;
 
 typedef struct murk_hit {
     float t;
@@ -118,6 +120,18 @@ typedef struct murk_host {
     float (*light_pdf)(const murk_scene *scene, murk_vec3 p, const murk_hit *hit);
     murk_rgb (*background)(const murk_scene *scene, murk_vec3 dir);
     const murk_medium *(*camera_medium)(const murk_scene *scene);
+    /* Media (murk/medium.h). density() is the field at a world point; walk_init/walk_next step
+     * through the majorant grid along ray->o + t ray->d for t in [t0, t1] (see murk_majorant_walk). */
+    float (*density)(const murk_density *d, murk_vec3 p);
+    void (*walk_init)(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
+    int (*walk_next)(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
+    /* Logs a warning the first time this exact message is given in a run; later repeats are counted
+     * and summarised at the end. Thread-safe. */
+    void (*warn_once)(const char *fmt, ...) MURK_PRINTF(1, 2);
+    /* Henyey-Greenstein phase function, wo and wi pointing away from the scattering point (forward
+     * scattering, g > 0, favours wi = -wo). phase_eval is also the pdf of phase_sample. */
+    float (*phase_eval)(float g, murk_vec3 wo, murk_vec3 wi);
+    murk_vec3 (*phase_sample)(float g, murk_vec3 wo, const float u[2], float *pdf);
 } murk_host;
 
 /* A parameter's value at a hit: the texture if one was given, else the constant. */

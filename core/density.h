@@ -1,0 +1,104 @@
+/* density.h — scalar density fields, their majorant/minorant grids and a 3-D DDA. Internal to libmurk.
+ *
+ * A field is either a constant (infinite extent) or a dense grid of float voxels over a world-space
+ * box [lo, hi] (DESIGN §5): voxel values sit at the CENTRES of the res[0] x res[1] x res[2] cells of
+ * that box; murk_field_eval interpolates trilinearly between centres, clamps to the nearest centre
+ * in the border half-cells (so the value there is constant along the clamped axis) and returns 0
+ * outside the closed box (and for NaN positions). Grid values are finite and >= 0.
+ *
+ * Sources of grids:
+ *   - Mitsuba 3 .vol files ('V','O','L',3; float32 only; ONE channel only: files with 3 or more
+ *     channels are rejected rather than silently reduced to channel 0, because a multi-channel .vol
+ *     is an albedo/colour grid far more often than a density);
+ *   - NanoVDB .nvdb files (first float grid; uncompressed segments or raw grid buffers; the active
+ *     index bounding box is densified; voxel ijk's value sits at map(ijk), so the world box is the
+ *     map of [min - 1/2, max + 1/2]; only axis-aligned positive-scale maps are accepted);
+ *   - a procedural fBm cloud baked into a res^3 grid, so it is exactly as trilinear as a file grid.
+ *
+ * Loaders return NULL and write "path: what is wrong" into err; nothing is leaked on failure.
+ *
+ * The bound grid divides the field's box into cells and stores, per cell, a majorant and a minorant
+ * that bound murk_field_eval over the closed cell: the max/min of every voxel whose interpolation
+ * support overlaps the cell (clamped border half-cells included) — a guaranteed bound, attained
+ * where the cell holds those voxels' centres. The grid covers exactly the field's box, so no cell
+ * reaches outside it (outside, the density is 0 and the DDA reports zero segments).
+ *
+ * Fields and bound grids are immutable after creation: any number of threads may read them. */
+#ifndef MURK_DENSITY_H
+#define MURK_DENSITY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "murk/math.h"
+
+/* Largest grid accepted from a file or built procedurally (4 GiB of floats). */
+#define MURK_FIELD_MAX_VOXELS ((uint64_t)1 << 30)
+
+typedef struct murk_field murk_field;
+
+murk_field *murk_field_constant(float value); /* NULL if value is negative or not finite */
+/* A grid field over [lo, hi] copying data[((z*res[1] + y)*res[0] + x)]; NULL if a resolution is < 1,
+ * the grid is too large, the box is not finite with lo < hi, a value is negative or not finite, or
+ * out of memory. */
+murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi, const float *data);
+murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen);
+/* Writes a grid field as a 1-channel float32 .vol (temporary file + rename); -1 on error (also for a
+ * constant field, which has no grid). A saved-then-loaded field is bitwise identical. */
+int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen);
+murk_field *murk_field_nvdb_load(const char *path, char *err, size_t errlen);
+/* fBm cloud in [lo, hi]: res^3 voxels (2..1024), frequency in features per box width (> 0),
+ * octaves 1..16, coverage in [0, 1] (larger fills more of the box). Deterministic for a seed; the
+ * outermost voxel layer is 0 so the density falls to 0 at the box faces; normalised so the maximum
+ * voxel is exactly 1 (unless the cloud is empty). NULL on invalid arguments or out of memory. */
+murk_field *murk_field_cloud(murk_vec3 lo, murk_vec3 hi, int res, uint64_t seed, float frequency,
+                             int octaves, float coverage);
+
+float murk_field_eval(const murk_field *f, murk_vec3 p);
+/* lo/hi = the box (±INFINITY and *infinite = 1 for a constant field). Any pointer may be NULL. */
+void murk_field_bounds(const murk_field *f, murk_vec3 *lo, murk_vec3 *hi, int *infinite);
+/* Max / min of murk_field_eval over the box (the voxel extremes; outside the box it is 0). */
+float murk_field_max(const murk_field *f);
+float murk_field_min(const murk_field *f);
+/* Grid access for savers and tests: resolution (1,1,1 for a constant) and voxels (NULL for a
+ * constant), data[((z*res[1] + y)*res[0] + x)]. */
+void murk_field_grid(const murk_field *f, int res[3], const float **data);
+void murk_field_free(murk_field *f);
+
+/* Majorant/minorant grid over the field's box; cell (x,y,z) is maj/min[(z*res[1] + y)*res[0] + x].
+ * For a constant field: one cell, lo/hi = ∓INFINITY, maj = min = the value. */
+typedef struct murk_bound_grid {
+    int res[3];
+    murk_vec3 lo, hi;
+    float *maj, *min;
+} murk_bound_grid;
+
+/* target_res cells along the box's longest axis, proportionally fewer (at least 1) along the others
+ * (a constant field always gets one cell). Returns 0, or -1 if target_res < 1, the grid would exceed
+ * MURK_FIELD_MAX_VOXELS cells, or out of memory (g is then zeroed). */
+int murk_bound_grid_build(const murk_field *f, int target_res, murk_bound_grid *g);
+void murk_bound_grid_free(murk_bound_grid *g);
+
+/* DDA over a bound grid. murk_dda_next yields consecutive half-open segments [ta, tb) that exactly
+ * tile [t0, t1]: the first ta is t0, each ta equals the previous tb bitwise, the last tb is t1.
+ * The parts of [t0, t1] outside the grid box (or the whole range, for a ray missing the box) come
+ * out as segments with maj = min = 0 and cell = {-1,-1,-1} — the density is 0 there — so a tracker
+ * can treat every segment alike. Segments inside the box carry their cell's bounds and index.
+ * Yields nothing when !(t0 < t1) (including NaN). t1 may be INFINITY. The ray direction need not be
+ * unit length; zero and -0 components are fine; r->tmin/tmax are ignored (t0/t1 rule). */
+typedef struct murk_dda {
+    const murk_bound_grid *g;
+    double o[3], d[3];    /* ray origin and direction */
+    double inv_d[3], h[3]; /* 1/d (unused where d is 0); the grid's cell size */
+    float t, t1;          /* start of the next segment; end of the range */
+    float tin, tout;      /* the ray's parameter range inside the grid box (tin > tout: missed) */
+    int phase;            /* before the box, entering, inside, after the box, done */
+    int idx[3], step[3];  /* current cell and step direction per axis */
+    int cell[3];          /* the cell of the segment last returned ({-1,-1,-1} outside the box) */
+} murk_dda;
+
+void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, float t0, float t1);
+/* Returns 1 and fills the outputs (any may be NULL) for the next segment, 0 when done. */
+int murk_dda_next(murk_dda *it, float *ta, float *tb, float *maj, float *min);
+
+#endif

@@ -1,0 +1,365 @@
+/* media.c — the scene's media: parsing `media:`, density fields and their majorant/minorant grids,
+ * instantiating tracker plugins, and the host services trackers call (density, majorant walk,
+ * once-only warnings, Henyey-Greenstein phase function).
+ *
+ *   media:
+ *     NAME:
+ *       type: delta                 # the tracker plugin
+ *       density: { constant: 1 }    # or { grid: file.vol } / { grid: file.nvdb } /
+ *                                   #    { cloud: { min, max, seed, frequency, octaves, coverage, resolution } }
+ *       sigma_a: [r, g, b]          # absorption per unit density (default 0)
+ *       sigma_s: [r, g, b]          # scattering per unit density (default 1)
+ *       scale: 1                    # multiplies sigma_a and sigma_s
+ *       g: 0                        # Henyey-Greenstein asymmetry
+ *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (warned)
+ *       majorant_resolution: 16     # majorant grid cells along the field's longest axis
+ *       ...                         # the tracker's own parameters */
+#include "media.h"
+#include "density.h"
+#include "host.h"
+#include "util.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct murk_density {
+    murk_field *field;
+    murk_bound_grid grid;
+    float factor;
+};
+
+typedef struct walk {
+    murk_dda dda;
+    float factor;
+} walk;
+
+_Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
+
+/* ---- host services ------------------------------------------------------------------------- */
+
+float murk_media_density(const murk_density *d, murk_vec3 p) { return murk_field_eval(d->field, p); }
+
+void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w)
+{
+    walk *k = (walk *)(void *)w;
+    murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
+    k->factor = d->factor;
+}
+
+int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
+{
+    walk *k = (walk *)(void *)w;
+    float mx = 0.0f, mn = 0.0f;
+    int r = murk_dda_next(&k->dda, ta, tb, &mx, &mn);
+    if (dmax)
+        *dmax = mx * k->factor;
+    if (dmin)
+        *dmin = mn;
+    return r;
+}
+
+static pthread_mutex_t warn_lock = PTHREAD_MUTEX_INITIALIZER;
+static struct { char *msg; unsigned long count; } warned[128];
+static int nwarned;
+
+void murk_warn_once(const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    pthread_mutex_lock(&warn_lock);
+    int i = 0;
+    while (i < nwarned && strcmp(warned[i].msg, buf) != 0)
+        i++;
+    if (i < nwarned) {
+        warned[i].count++;
+    } else if (nwarned < (int)(sizeof warned / sizeof warned[0])) {
+        warned[nwarned].msg = murk_strdup(buf);
+        warned[nwarned].count = 1;
+        nwarned++;
+        murk_log(MURK_LOG_WARN, "%s", buf);
+    }
+    pthread_mutex_unlock(&warn_lock);
+}
+
+void murk_warn_summary(void)
+{
+    pthread_mutex_lock(&warn_lock);
+    for (int i = 0; i < nwarned; i++) {
+        if (warned[i].count > 1)
+            murk_log(MURK_LOG_WARN, "(%lu times in all) %s", warned[i].count, warned[i].msg);
+        free(warned[i].msg);
+    }
+    nwarned = 0;
+    pthread_mutex_unlock(&warn_lock);
+}
+
+float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi)
+{
+    float cost = murk_dot(wo, wi);
+    float denom = 1.0f + g * g + 2.0f * g * cost;
+    return (1.0f / (4.0f * MURK_PI)) * (1.0f - g * g) / (denom * sqrtf(fmaxf(denom, 1e-12f)));
+}
+
+murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf)
+{
+    float cost;
+    if (fabsf(g) < 1e-3f) {
+        cost = 1.0f - 2.0f * u[0];
+    } else {
+        float sq = (1.0f - g * g) / (1.0f + g - 2.0f * g * u[0]);
+        cost = -(1.0f + g * g - sq * sq) / (2.0f * g);
+    }
+    cost = fminf(1.0f, fmaxf(-1.0f, cost));
+    float sint = sqrtf(fmaxf(0.0f, 1.0f - cost * cost)), phi = 2.0f * MURK_PI * u[1];
+    murk_vec3 t, b;
+    murk_basis(wo, &t, &b);
+    murk_vec3 wi = murk_normalize(murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, wo));
+    *pdf = murk_phase_hg_eval(g, wo, wi);
+    return wi;
+}
+
+/* ---- scene loading ------------------------------------------------------------------------- */
+
+static int number(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err, size_t errlen)
+{
+    char *end;
+    if (!n || n->kind != MURK_Y_SCALAR)
+        return murk_yerr(err, errlen, n, "%s must be a number", what);
+    *out = strtod(n->str, &end);
+    if (!*n->str || *end || !isfinite(*out))
+        return murk_yerr(err, errlen, n, "%s must be a number, got '%s'", what, n->str);
+    if (*out < lo || *out > hi)
+        return murk_yerr(err, errlen, n, "%s must be in [%g, %g], got %g", what, lo, hi, *out);
+    return 0;
+}
+
+static int rgb(const murk_ynode *n, const char *what, double lo, double hi, murk_rgb *out, char *err, size_t errlen)
+{
+    double v[3];
+    if (n->kind == MURK_Y_SCALAR) {
+        if (number(n, what, lo, hi, &v[0], err, errlen))
+            return -1;
+        v[1] = v[2] = v[0];
+    } else if (n->kind == MURK_Y_SEQ && n->n == 3) {
+        for (int i = 0; i < 3; i++)
+            if (number(n->items[i], what, lo, hi, &v[i], err, errlen))
+                return -1;
+    } else {
+        return murk_yerr(err, errlen, n, "%s must be [r, g, b] or one number", what);
+    }
+    *out = murk_rgb3((float)v[0], (float)v[1], (float)v[2]);
+    return 0;
+}
+
+static int vec3(const murk_ynode *n, const char *what, murk_vec3 *out, char *err, size_t errlen)
+{
+    if (!n || n->kind != MURK_Y_SEQ || n->n != 3)
+        return murk_yerr(err, errlen, n, "%s must be [x, y, z]", what);
+    double v[3];
+    for (int i = 0; i < 3; i++)
+        if (number(n->items[i], what, -1e30, 1e30, &v[i], err, errlen))
+            return -1;
+    *out = murk_v3((float)v[0], (float)v[1], (float)v[2]);
+    return 0;
+}
+
+static int only_keys(const murk_ynode *m, const char *what, const char *const *keys, size_t nk, char *err, size_t errlen)
+{
+    for (size_t i = 0; i < m->n; i++) {
+        size_t j = 0;
+        while (j < nk && strcmp(m->keys[i], keys[j]) != 0)
+            j++;
+        if (j < nk)
+            continue;
+        const char *s = murk_did_you_mean(m->keys[i], keys, nk);
+        return murk_yerr_key(err, errlen, m, i, "unknown key '%s' in %s%s%s%s", m->keys[i], what, s ? " (did you mean '" : "",
+                             s ? s : "", s ? "'?)" : "");
+    }
+    return 0;
+}
+
+static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"min", "max", "seed", "frequency", "octaves", "coverage", "resolution"};
+    if (c->kind != MURK_Y_MAP) {
+        murk_yerr(err, errlen, c, "cloud must be a map { min, max, seed, frequency, octaves, coverage, resolution }");
+        return NULL;
+    }
+    if (only_keys(c, "cloud", keys, 7, err, errlen))
+        return NULL;
+    murk_vec3 lo = murk_v3(-0.5f, -0.5f, -0.5f), hi = murk_v3(0.5f, 0.5f, 0.5f);
+    double seed = 1, freq = 3, oct = 5, cov = 0.5, res = 64;
+    const murk_ynode *k;
+    if (((k = murk_ymap_get(c, "min")) && vec3(k, "cloud.min", &lo, err, errlen)) ||
+        ((k = murk_ymap_get(c, "max")) && vec3(k, "cloud.max", &hi, err, errlen)) ||
+        ((k = murk_ymap_get(c, "seed")) && number(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
+        ((k = murk_ymap_get(c, "frequency")) && number(k, "cloud.frequency", 0.01, 1000, &freq, err, errlen)) ||
+        ((k = murk_ymap_get(c, "octaves")) && number(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
+        ((k = murk_ymap_get(c, "coverage")) && number(k, "cloud.coverage", 0, 1, &cov, err, errlen)) ||
+        ((k = murk_ymap_get(c, "resolution")) && number(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
+        return NULL;
+    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
+        murk_yerr(err, errlen, c, "cloud: max must exceed min on every axis");
+        return NULL;
+    }
+    murk_field *f = murk_field_cloud(lo, hi, (int)res, (uint64_t)seed, (float)freq, (int)oct, (float)cov);
+    if (!f)
+        murk_yerr(err, errlen, c, "cloud: could not build the field (out of memory?)");
+    return f;
+}
+
+static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"constant", "grid", "cloud"};
+    if (d->kind != MURK_Y_MAP || d->n != 1) {
+        murk_yerr(err, errlen, d, "density must be one of { constant: V }, { grid: FILE.vol|FILE.nvdb }, { cloud: {...} }");
+        return NULL;
+    }
+    if (only_keys(d, "density", keys, 3, err, errlen))
+        return NULL;
+    const murk_ynode *k;
+    if ((k = murk_ymap_get(d, "constant"))) {
+        double v;
+        if (number(k, "density.constant", 0, 1e30, &v, err, errlen))
+            return NULL;
+        return murk_field_constant((float)v);
+    }
+    if ((k = murk_ymap_get(d, "grid"))) {
+        if (k->kind != MURK_Y_SCALAR || !*k->str) {
+            murk_yerr(err, errlen, k, "density.grid must be a file name");
+            return NULL;
+        }
+        char *path = murk_path_relative_to(s->doc.file, k->str);
+        char ferr[768];
+        size_t l = strlen(path);
+        murk_field *f = (l > 5 && strcmp(path + l - 5, ".nvdb") == 0) ? murk_field_nvdb_load(path, ferr, sizeof ferr)
+                                                                        : murk_field_vol_load(path, ferr, sizeof ferr);
+        free(path);
+        if (!f)
+            murk_yerr(err, errlen, k, "density grid: %s", ferr);
+        return f;
+    }
+    return load_cloud(murk_ymap_get(d, "cloud"), err, errlen);
+}
+
+static const char *const core_keys[] = {"type", "density", "sigma_a", "sigma_s", "scale", "g", "majorant_factor",
+                                        "majorant_resolution"};
+#define NCORE (sizeof core_keys / sizeof core_keys[0])
+
+static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
+                       size_t errlen)
+{
+    char who[256];
+    snprintf(who, sizeof who, "medium '%s'", name);
+    if (m->kind != MURK_Y_MAP)
+        return murk_yerr(err, errlen, m, "%s must be a map of keys", who);
+    const murk_ynode *t = murk_ymap_get(m, "type");
+    if (!t)
+        return murk_yerr(err, errlen, m, "%s is missing the required key 'type' (a tracker: delta, decomposition, "
+                                         "spectral, spectral_mis, naive_spectral)", who);
+    if (t->kind != MURK_Y_SCALAR)
+        return murk_yerr(err, errlen, t, "%s: type must be a plugin name", who);
+    char lerr[1024];
+    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_MEDIUM, t->str, lerr, sizeof lerr);
+    if (!p)
+        return murk_yerr(err, errlen, t, "%s: %s", who, lerr);
+    snprintf(who, sizeof who, "medium '%s' (%s)", name, t->str);
+    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
+    if (murk_scene_read_plugin_params(s, p->desc, m, who, core_keys, NCORE, vals, err, errlen))
+        return -1;
+
+    murk_medium_data *md = &nm->data;
+    md->size = sizeof *md;
+    md->sigma_a = murk_rgb1(0.0f);
+    md->sigma_s = murk_rgb1(1.0f);
+    md->majorant_factor = 1.0f;
+    double scale = 1.0, g = 0.0, mf = 1.0, mres = 16;
+    const murk_ynode *k;
+    if (((k = murk_ymap_get(m, "sigma_a")) && rgb(k, "sigma_a", 0, 1e8, &md->sigma_a, err, errlen)) ||
+        ((k = murk_ymap_get(m, "sigma_s")) && rgb(k, "sigma_s", 0, 1e8, &md->sigma_s, err, errlen)) ||
+        ((k = murk_ymap_get(m, "scale")) && number(k, "scale", 0, 1e8, &scale, err, errlen)) ||
+        ((k = murk_ymap_get(m, "g")) && number(k, "g (Henyey-Greenstein asymmetry)", -0.99, 0.99, &g, err, errlen)) ||
+        ((k = murk_ymap_get(m, "majorant_factor")) && number(k, "majorant_factor", 1e-3, 1e3, &mf, err, errlen)) ||
+        ((k = murk_ymap_get(m, "majorant_resolution")) && number(k, "majorant_resolution", 1, 256, &mres, err, errlen)))
+        return -1;
+    md->sigma_a = murk_rgb_scale(md->sigma_a, (float)scale);
+    md->sigma_s = murk_rgb_scale(md->sigma_s, (float)scale);
+    md->g = (float)g;
+    md->majorant_factor = (float)mf;
+    const murk_ynode *dn = murk_ymap_get(m, "density");
+    nm->density = murk_xmalloc(sizeof *nm->density);
+    nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
+    if (!nm->density->field)
+        return -1;
+    if (murk_bound_grid_build(nm->density->field, (int)mres, &nm->density->grid) != 0)
+        return murk_yerr(err, errlen, dn ? dn : m, "%s: cannot build the majorant grid (out of memory)", who);
+    nm->density->factor = (float)mf;
+    md->density = nm->density;
+    md->density_max = murk_field_max(nm->density->field);
+    md->density_min = murk_field_min(nm->density->field);
+    md->name = nm->name = murk_strdup(name);
+    if (mf < 1.0)
+        murk_log(MURK_LOG_WARN,
+                 "%s: majorant_factor %g < 1: the majorant no longer bounds the density; trackers fall back to "
+                 "weighted collisions (unbiased, noisier)", who, mf);
+    float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s)), sm = fmaxf(1e-30f, st);
+    float mn = fminf(md->sigma_a.c[0] + md->sigma_s.c[0], fminf(md->sigma_a.c[1] + md->sigma_s.c[1], md->sigma_a.c[2] + md->sigma_s.c[2]));
+    if (st > 0 && mn / sm < 1e-2f)
+        murk_log(MURK_LOG_INFO, "%s: extinction varies %.0f:1 across channels (strongly chromatic)", who,
+                 mn > 0 ? sm / mn : INFINITY);
+
+    const murk_medium_vt *vt = p->desc->vtable;
+    char cerr[512] = "";
+    if (vt->create(murk_host_table(), md, vals, &nm->m.self, cerr, sizeof cerr) != 0)
+        return murk_yerr(err, errlen, m, "%s: %s", who, cerr[0] ? cerr : "create() failed");
+    nm->m.vt = vt;
+    nm->m.name = nm->name;
+    nm->m.data = md;
+    nm->plugin = p;
+    return 0;
+}
+
+static void medium_free(murk_named_medium *nm)
+{
+    if (nm->m.vt && nm->m.self)
+        nm->m.vt->destroy(nm->m.self);
+    if (nm->density) {
+        murk_field_free(nm->density->field);
+        murk_bound_grid_free(&nm->density->grid);
+        free(nm->density);
+    }
+    free(nm->name);
+}
+
+int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
+    if (n->kind != MURK_Y_MAP)
+        return murk_yerr(err, errlen, n, "media must be a map of NAME: { type: TRACKER, ... }");
+    s->media = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->media);
+    for (size_t i = 0; i < n->n; i++) {
+        murk_named_medium *nm = &s->media[i];
+        if (load_medium(s, n->keys[i], n->items[i], nm, err, errlen) != 0) {
+            medium_free(nm);
+            memset(nm, 0, sizeof *nm);
+            return -1;
+        }
+        s->nmedia++;
+    }
+    return 0;
+}
+
+void murk_media_free(murk_scene *s)
+{
+    for (size_t i = 0; i < s->nmedia; i++)
+        medium_free(&s->media[i]);
+    free(s->media);
+    s->media = NULL;
+    s->nmedia = 0;
+}

@@ -1,0 +1,21 @@
+/* media.h — the core side of participating media: the scene's `media:` block, density fields with
+ * their majorant grids, and the host services trackers use. Internal to libmurk. */
+#ifndef MURK_MEDIA_H
+#define MURK_MEDIA_H
+
+#include "murk/medium.h"
+#include "scene.h"
+
+int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+void murk_media_free(murk_scene *s);
+
+float murk_media_density(const murk_density *d, murk_vec3 p);
+void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
+int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
+void murk_warn_once(const char *fmt, ...) MURK_PRINTF(1, 2);
+/* Prints how often each once-only warning repeated, and forgets them. */
+void murk_warn_summary(void);
+float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi);
+murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf);
+
+#endif

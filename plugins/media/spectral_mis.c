@@ -1,0 +1,122 @@
+/* spectral_mis — unidirectional spectral MIS (Miller, Georgiev, Jarosz 2019).
+ *
+ * Parameters: none of its own.
+ *
+ * Each path has a hero channel h, chosen uniformly by the integrator. Free flights are delta-tracked
+ * with the hero channel's extinction against one majorant shared by all channels (mu = max density of
+ * the grid cell x max channel of sigma_t): a tentative collision at x is real with probability
+ * q_h = sigma_t,h(x) / mu. Because the majorant is common, the distance pdfs are equal for every channel
+ * and only the event choices differ: channel k's own technique would have chosen the same event with
+ * q_k (real) or 1 - q_k (null). The tracker returns
+ *     weight_c = f_c / p_h   (real: sigma_s,c(x) / (mu q_h); null: (1 - sigma_t,c(x)/mu) / (1 - q_h))
+ *     pdf_k    = p_k / p_h   (real: q_k / q_h;              null: (1 - q_k) / (1 - q_h))
+ * and the integrator divides the path's product of weights by the mean over channels of the product
+ * of pdf ratios: the balance heuristic over channels, applied to the whole path (not per segment),
+ * together with NEE. A channel whose extinction differs wildly from the hero's no longer blows up the
+ * weights as in per-channel delta tracking: some hero samples it well. Where the majorant fails to
+ * bound, q_k = |a| / (|a| + |1 - a|) keeps every technique valid (weighted, unbiased) and murk says so
+ * once. Shadow rays use ratio tracking. */
+#include "murk/medium.h"
+#include "murk/tracking.h"
+
+#include <stdio.h>
+
+typedef struct smis {
+    const murk_host *host;
+    const murk_medium_data *d;
+    murk_rgb sigma_t;
+    float smax;
+} smis;
+
+static int smis_create(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
+                       char *err, size_t errlen)
+{
+    (void)params;
+    if (host->size < sizeof(murk_host)) {
+        snprintf(err, errlen, "this murk's host table lacks the media services");
+        return -1;
+    }
+    smis *m = host->alloc(sizeof *m);
+    if (!m)
+        return -1;
+    m->host = host;
+    m->d = data;
+    m->sigma_t = murk_sigma_t(data);
+    m->smax = murk_rgb_max(m->sigma_t);
+    *self = m;
+    return 0;
+}
+
+static void smis_destroy(void *self)
+{
+    smis *m = self;
+    if (m)
+        m->host->free(m);
+}
+
+static int smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                       murk_medium_event *ev)
+{
+    const smis *m = self;
+    const murk_host *h = m->host;
+    int hero = ctx->hero;
+    ev->scattered = 0;
+    ev->t = ray->tmax;
+    ev->weight = murk_rgb1(1.0f);
+    ev->pdf = murk_rgb1(1.0f);
+    if (!(m->smax > 0.0f))
+        return 0;
+    murk_majorant_walk w;
+    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
+    float ta, tb, dmax, dmin;
+    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
+        float mu = dmax * m->smax;
+        if (!(mu > 0.0f))
+            continue;
+        for (float t = ta;;) {
+            t += murk_sample_exp(rng, mu);
+            if (!(t < tb))
+                break;
+            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t));
+            float a[3], q[3];
+            for (int k = 0; k < 3; k++) {
+                a[k] = dens * m->sigma_t.c[k] / mu;
+                q[k] = murk_real_prob(a[k], 1.0f - a[k]);
+            }
+            if (a[hero] > 1.0f)
+                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral MIS uses "
+                             "weighted collisions (unbiased, noisier)", m->d->name);
+            if (murk_rng_float(rng) < q[hero]) {
+                for (int k = 0; k < 3; k++) {
+                    ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (mu * q[hero]);
+                    ev->pdf.c[k] *= q[k] / q[hero];
+                }
+                ev->scattered = 1;
+                ev->t = t;
+                return 1;
+            }
+            for (int k = 0; k < 3; k++) {
+                ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
+                ev->pdf.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
+            }
+        }
+    }
+    return 0;
+}
+
+static murk_rgb smis_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    (void)ctx;
+    const smis *m = self;
+    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
+}
+
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), smis_create, smis_destroy, smis_sample,
+                                  smis_transmittance};
+
+static const murk_plugin_desc desc = {
+    sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, "spectral_mis",
+    "spectral MIS (Miller et al. 2019): hero-channel tracking, balance heuristic over channels", NULL, 0, &vt,
+};
+
+MURK_PLUGIN(&desc)
