@@ -37,10 +37,12 @@
 #include <openexr.h>
 #include <png.h>
 
+#ifndef MURK_PRINTF /* as in murk/plugin.h */
 #if defined(__GNUC__) || defined(__clang__)
 #define MURK_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #else
 #define MURK_PRINTF(a, b)
+#endif
 #endif
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -81,7 +83,8 @@ static char *dup_n(const char *s, size_t n)
 /* Checks w, h and that 3*w*h floats (and 12*w bytes per row) can be addressed. */
 static int size_ok(long long w, long long h)
 {
-    return w > 0 && h > 0 && w <= INT_MAX / 12 && h <= INT_MAX && (unsigned long long)w * (unsigned long long)h <= SIZE_MAX / 12;
+    return w > 0 && h > 0 && w <= INT_MAX / 12 && h <= INT_MAX &&
+           (unsigned long long)w * (unsigned long long)h <= SIZE_MAX / 12;
 }
 
 /* Flushes a completely written temporary to disk and closes it (fd is closed in any case). */
@@ -484,8 +487,8 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
     if (exr_get_storage(ctx, 0, &storage) != EXR_ERR_SUCCESS ||
         (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED))
         return fail(err, errlen, "%s: deep EXR images are not supported", path);
-    if (exr_get_data_window(ctx, 0, &dw) != EXR_ERR_SUCCESS || exr_get_channels(ctx, 0, &chl) != EXR_ERR_SUCCESS ||
-        !chl)
+    if (exr_get_data_window(ctx, 0, &dw) != EXR_ERR_SUCCESS ||
+        exr_get_channels(ctx, 0, &chl) != EXR_ERR_SUCCESS || !chl)
         return fail(err, errlen, "%s: EXR header lacks a data window or channel list", path);
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
     if (!size_ok(w, h))
@@ -529,7 +532,9 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
     if (rc == 0) {
         rv = exr_read_pixels(ctx, storage, &dw, slots, img->rgb, (int)w, (int)h);
         if (rv != EXR_ERR_SUCCESS) {
-            const char *why = io->err ? strerror(io->err) : io->msg[0] ? io->msg : exr_get_default_error_message(rv);
+            const char *why = io->err     ? strerror(io->err)
+                              : io->msg[0] ? io->msg
+                                           : exr_get_default_error_message(rv);
             rc = fail(err, errlen, "%s: cannot decode EXR pixels: %s", path, why);
         }
     }

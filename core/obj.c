@@ -12,12 +12,15 @@
  * ends and tabs are accepted. Counts are checked against 32-bit limits and every allocation is
  * checked; on failure everything is freed and the mesh is left zeroed.
  *
- * Numbers: decimal numbers with at most 7 significant digits and a small exponent (nearly every
- * OBJ coordinate) are converted exactly and locale-independently by Clinger's fast path in float
- * arithmetic; anything else goes through strtof, which is correctly rounded too. */
+ * Numbers: when the digits form an integer of at most 2^24 and the decimal exponent is within
+ * +-10 (nearly every OBJ coordinate), the value is computed exactly and locale-independently with
+ * one float multiplication or division (Clinger's fast path); anything else goes to strtof in the
+ * "C" locale (switched for this thread only), which is correctly rounded too: both give the same
+ * bits whatever locale the application has set. */
 #include "obj.h"
 
 #include <errno.h>
+#include <locale.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -25,10 +28,12 @@
 #include <string.h>
 #include <sys/types.h>
 
+#ifndef MURK_PRINTF /* as in murk/plugin.h */
 #if defined(__GNUC__) || defined(__clang__)
 #define MURK_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #else
 #define MURK_PRINTF(a, b)
+#endif
 #endif
 
 #define NO_INDEX UINT32_MAX
@@ -53,6 +58,7 @@ typedef struct objparse {
     size_t nidx, capidx;
     uint32_t *face;             /* the current face's unified vertices */
     size_t capface;
+    locale_t c_locale;          /* for strtof, created on first use; (locale_t)0 if none */
 } objparse;
 
 MURK_PRINTF(3, 4)
@@ -131,9 +137,22 @@ static int is_digit(char c)
     return c >= '0' && c <= '9';
 }
 
+/* strtof of the NUL-terminated s in the "C" locale, whatever the application's locale. */
+static float strtof_c(objparse *o, const char *s, char **end)
+{
+    if (o->c_locale == (locale_t)0)
+        o->c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
+    if (o->c_locale == (locale_t)0) /* out of memory: the current locale is most likely "C" anyway */
+        return strtof(s, end);
+    locale_t old = uselocale(o->c_locale);
+    float f = strtof(s, end);
+    uselocale(old);
+    return f;
+}
+
 /* Parses the decimal number [s, e) into *out. Returns 0, -1 if malformed, -2 if out of range for a
  * float. The grammar is [+-]? (digits [. digits?] | . digits) ([eE] [+-]? digits)?. */
-static int parse_float(const char *s, const char *e, float *out)
+static int parse_float(objparse *o, const char *s, const char *e, float *out)
 {
     static const float pow10f[11] = {1e0f, 1e1f, 1e2f, 1e3f, 1e4f, 1e5f, 1e6f, 1e7f, 1e8f, 1e9f, 1e10f};
     const char *p = s;
@@ -200,11 +219,11 @@ static int parse_float(const char *s, const char *e, float *out)
             return -1;
         memcpy(tmp, s, n);
         tmp[n] = 0;
-        f = strtof(tmp, &end);
+        f = strtof_c(o, tmp, &end);
         int whole = end == tmp + n;
         if (tmp != buf)
             free(tmp);
-        if (!whole) /* only in a locale whose decimal point is not '.' */
+        if (!whole) /* cannot happen for text matching the grammar */
             return -1;
     }
     if (isinf(f))
@@ -213,26 +232,27 @@ static int parse_float(const char *s, const char *e, float *out)
     return 0;
 }
 
-/* Parses the numbers of a v/vt/vn line into vals (at most maxn; more is an error). Returns the
- * count, or -1 with the error set. */
-static int parse_floats(objparse *o, const char *p, const char *e, const char *kw, float *vals, int minn, int maxn)
+/* Parses the numbers after the keyword kw (named name) into vals: at least minn, at most maxn.
+ * Returns the count, or -1 with the error set. */
+static int parse_floats(objparse *o, const char *kw, const char *name, const char *p, const char *e, float *vals,
+                        int minn, int maxn)
 {
     int n = 0;
     for (p = skip_space(p, e); p < e; p = skip_space(p, e)) {
         const char *te = token_end(p, e);
         float f = 0.0f;
-        int r = parse_float(p, te, &f);
+        int r = parse_float(o, p, te, &f);
         if (r == -1)
             return fail_at(o, p, "bad number '%.*s'", (int)(te - p > 40 ? 40 : te - p), p);
         if (r == -2)
             return fail_at(o, p, "number out of range '%.*s'", (int)(te - p > 40 ? 40 : te - p), p);
         if (n == maxn)
-            return fail_at(o, p, "too many values for '%s' (at most %d)", kw, maxn);
+            return fail_at(o, p, "too many values for '%s' (at most %d)", name, maxn);
         vals[n++] = f;
         p = te;
     }
     if (n < minn)
-        return fail_at(o, kw, "'%s' needs at least %d values, got %d", kw, minn, n);
+        return fail_at(o, kw, "'%s' needs at least %d values, got %d", name, minn, n);
     return n;
 }
 
@@ -328,8 +348,8 @@ static int resolve(objparse *o, const char *tok, const char *te, const char *s, 
         return fail_at(o, tok, "index 0 is invalid in '%.*s' (OBJ indices start at 1)",
                        (int)(te - tok > 40 ? 40 : te - tok), tok);
     if (v > count)
-        return fail_at(o, tok, "%s index %s%llu out of range in '%.*s' (%zu defined)", what, neg ? "-" : "",
-                       (unsigned long long)v, (int)(te - tok > 40 ? 40 : te - tok), tok, count);
+        return fail_at(o, tok, "%s index %.*s out of range (%zu defined)", what, (int)(e - s > 40 ? 40 : e - s),
+                       s, count);
     *out = (uint32_t)(neg ? count - v : v - 1);
     return 0;
 }
@@ -345,7 +365,8 @@ static int parse_face_vertex(objparse *o, const char *tok, const char *te, uint3
     if (resolve(o, tok, te, tok, s1 ? s1 : te, o->nv, "vertex", &k.v) != 0)
         return -1;
     /* v/vt or v/vt/vn; "v//vn" has no vt */
-    if (s1 && (!s2 || s2 > s1 + 1) && resolve(o, tok, te, s1 + 1, s2 ? s2 : te, o->nvt, "texture coordinate", &k.t) != 0)
+    if (s1 && (!s2 || s2 > s1 + 1) &&
+        resolve(o, tok, te, s1 + 1, s2 ? s2 : te, o->nvt, "texture coordinate", &k.t) != 0)
         return -1;
     if (s2 && resolve(o, tok, te, s2 + 1, te, o->nvn, "normal", &k.n) != 0)
         return -1;
@@ -395,28 +416,25 @@ static int keyword_is(const char *k, const char *ke, const char *word)
 static int parse_line(objparse *o, const char *line, size_t len)
 {
     const char *e = line + len, *hash = memchr(line, '#', len);
-    const char *nul = memchr(line, 0, len);
     float vals[7];
-    o->line = line;
-    if (nul)
-        return fail_at(o, nul, "NUL byte in line");
+    o->line = line; /* a NUL byte is just a character that fits no token */
     if (hash)
         e = hash;
     const char *k = skip_space(line, e);
     const char *ke = token_end(k, e);
     if (keyword_is(k, ke, "v")) {
-        if (parse_floats(o, ke, e, k, vals, 3, 7) < 0)
+        if (parse_floats(o, k, "v", ke, e, vals, 3, 7) < 0)
             return -1;
         return push_floats(o, &o->v, &o->nv, &o->capv, vals, 3);
     }
     if (keyword_is(k, ke, "vt")) {
         vals[1] = 0.0f;
-        if (parse_floats(o, ke, e, k, vals, 1, 3) < 0)
+        if (parse_floats(o, k, "vt", ke, e, vals, 1, 3) < 0)
             return -1;
         return push_floats(o, &o->vt, &o->nvt, &o->capvt, vals, 2);
     }
     if (keyword_is(k, ke, "vn")) {
-        if (parse_floats(o, ke, e, k, vals, 3, 3) < 0)
+        if (parse_floats(o, k, "vn", ke, e, vals, 3, 3) < 0)
             return -1;
         return push_floats(o, &o->vn, &o->nvn, &o->capvn, vals, 3);
     }
@@ -466,6 +484,8 @@ static void parse_free(objparse *o)
     free(o->table);
     free(o->idx);
     free(o->face);
+    if (o->c_locale != (locale_t)0)
+        freelocale(o->c_locale);
 }
 
 int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
@@ -491,9 +511,10 @@ int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
         errno = 0;
         ssize_t n = getline(&line, &cap, f);
         if (n < 0) {
-            if (ferror(f) || !feof(f))
-                rc = errno == ENOMEM ? oom(&o)
-                                     : fail(err, errlen, "%s: read error: %s", path, strerror(errno ? errno : EIO));
+            if (ferror(f) || !feof(f)) {
+                int e = errno ? errno : EIO;
+                rc = e == ENOMEM ? oom(&o) : fail(err, errlen, "%s: read error: %s", path, strerror(e));
+            }
             break;
         }
         o.lineno++;
