@@ -36,8 +36,9 @@
  * (wo, wi) term by term, so reciprocal. M has no closed form: it is tabulated below over
  * (t = sqrt(mu), r = sqrt(alpha)) and read bilinearly; every table entry carries a local safety margin
  * so that the interpolated M is never below the true M (checked densely by the generator), which keeps
- * the bound E <= 1 rigorous. Mavg is integrated exactly from that same interpolant. Regenerate with
+ * the bound E <= 1 rigorous. Mavg is integrated exactly from that same interpolant. To regenerate, run
  *     cc -O2 -DMURK_GGX_GENERATE_TABLES -I core/include plugins/materials/ggx.c -lm -o ggxgen && ./ggxgen
+ * (about 10 s) and paste its output over the BEGIN..END GENERATED TABLES block.
  *
  * Sampling: with probability P_spec the coat (visible-normal sampling of GGX with the spherical-cap
  * method of Dupuy & Benyoub 2023, then mirror reflection), otherwise the base (cosine-weighted
@@ -47,9 +48,9 @@
  * pdf_spec = D(h) G1(wo) / (4 mu_o); coat samples that reflect below the horizon are rejected (sample()
  * returns 0), so pdf() integrates to 1 minus that rejected mass.
  *
- * Robustness: wo.z <= 0 or wi.z <= 0 gives f = 0 and pdf = 0; sample() returns 0 for wo.z <= 0 and for
- * rejected or zero-pdf samples. All formulas are written without divisions by mu or tan theta, so
- * grazing directions (wo.z = 1e-7) stay finite. */
+ * Robustness: wo.z or wi.z below 1e-9 (the horizon, below it, NaN) gives f = 0 and pdf = 0; sample()
+ * returns 0 there and for rejected or zero-pdf samples. No formula divides by mu or tan theta alone, so
+ * grazing directions (wo.z = 1e-7) stay finite, and with alpha >= 0.001 every output is bounded. */
 #include "murk/material.h"
 
 #include <string.h>
@@ -68,6 +69,9 @@ static const murk_param params[P_COUNT] = {
 };
 
 #define GGX_ALPHA_MIN 1e-3f
+/* Cosines below this count as the horizon: it bounds f <= 0.5 D_max / (2 GGX_MU_MIN GGX_ALPHA_MIN) ~ 1e17
+ * and pdf <= D_max / (2 GGX_ALPHA_MIN) ~ 2e8, so nothing overflows even for subnormal cosines. */
+#define GGX_MU_MIN 1e-9f
 #define GGX_PSPEC_MIN 0.05f
 #define GGX_PSPEC_MAX 0.95f
 
@@ -297,6 +301,7 @@ typedef struct ggx_shade {
 } ggx_shade;
 
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
+static int above(float z) { return z >= GGX_MU_MIN; }                                /* NaN -> 0 */
 
 static void ggx_shade_at(const ggx *g, const murk_hit *hit, ggx_shade *sh)
 {
@@ -383,10 +388,9 @@ static int ggx_half(murk_vec3 wo, murk_vec3 wi, murk_vec3 *h)
 static murk_rgb ggx_eval_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
 {
     murk_rgb f = murk_rgb1(0.0f);
-    float mo_ = wo.z, mi_ = wi.z;
-    if (!(mo_ > 0.0f) || !(mi_ > 0.0f))
+    if (!above(wo.z) || !above(wi.z))
         return f;
-    float mu_o = fminf(mo_, 1.0f), mu_i = fminf(mi_, 1.0f);
+    float mu_o = fminf(wo.z, 1.0f), mu_i = fminf(wi.z, 1.0f);
     /* diffuse base */
     float kd = (1.0f - ggx_m_lookup(sh, mu_o)) * (1.0f - ggx_m_lookup(sh, mu_i)) /
                fmaxf(1.0f - sh->mavg, 1e-6f) * MURK_INV_PI;
@@ -409,7 +413,7 @@ static murk_rgb ggx_eval_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
 
 static float ggx_pdf_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
 {
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+    if (!above(wo.z) || !above(wi.z))
         return 0.0f;
     float mu_o = fminf(wo.z, 1.0f), mu_i = fminf(wi.z, 1.0f);
     float ps = ggx_pspec(sh, ggx_m_lookup(sh, mu_o));
@@ -464,7 +468,7 @@ static void ggx_destroy(void *self)
 
 static murk_rgb ggx_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
 {
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+    if (!above(wo.z) || !above(wi.z))
         return murk_rgb1(0.0f);
     ggx_shade sh;
     ggx_shade_at(self, hit, &sh);
@@ -473,7 +477,7 @@ static murk_rgb ggx_eval(const void *self, const murk_hit *hit, murk_vec3 wo, mu
 
 static float ggx_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
 {
-    if (!(wo.z > 0.0f) || !(wi.z > 0.0f))
+    if (!above(wo.z) || !above(wi.z))
         return 0.0f;
     ggx_shade sh;
     ggx_shade_at(self, hit, &sh);
@@ -483,7 +487,7 @@ static float ggx_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_v
 static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
 {
     memset(s, 0, sizeof *s);
-    if (!(wo.z > 0.0f))
+    if (!above(wo.z))
         return 0;
     ggx_shade sh;
     ggx_shade_at(self, hit, &sh);
@@ -499,7 +503,7 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
         float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1];
         wi = murk_v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
     }
-    if (!(wi.z > 0.0f))
+    if (!above(wi.z))
         return 0;
     float pdf = ggx_pdf_sh(&sh, wo, wi);
     murk_rgb f = ggx_eval_sh(&sh, wo, wi);
