@@ -8,6 +8,7 @@
 #include "murk/material.h"
 #include "murk/medium.h"
 
+#include <dirent.h>
 #include <dlfcn.h>
 #include <stdarg.h>
 #include <limits.h>
@@ -25,6 +26,8 @@ const char *murk_kind_name(int kind)
     default: return "unknown-kind";
     }
 }
+
+static const char *article(int kind) { return kind == MURK_KIND_INTEGRATOR ? "an" : "a"; }
 
 static void add_dir(murk_registry *r, const char *d, size_t len)
 {
@@ -189,8 +192,8 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
         rc = fail(err, errlen, path, "declares the name '%s' but its file is named '%.*s.so' (names must match)",
                   d->name ? d->name : "(null)", (int)blen, base);
     else if (kind && (int)d->kind != kind)
-        rc = fail(err, errlen, path, "'%s' is a %s plugin, not a %s", d->name, murk_kind_name((int)d->kind),
-                  murk_kind_name(kind));
+        rc = fail(err, errlen, path, "'%s' is %s %s plugin, not %s %s", d->name, article((int)d->kind),
+                  murk_kind_name((int)d->kind), article(kind), murk_kind_name(kind));
     else if (!d->vtable)
         rc = fail(err, errlen, path, "descriptor has no vtable");
     else if (*(const uint32_t *)d->vtable < vtable_min_size((int)d->kind))
@@ -227,8 +230,8 @@ const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *na
         if (strcmp(r->loaded[i]->desc->name, name) == 0) {
             const murk_plugin *p = r->loaded[i];
             if (kind && (int)p->desc->kind != kind) {
-                fail(err, errlen, p->path, "'%s' is a %s plugin, not a %s", name, murk_kind_name((int)p->desc->kind),
-                     murk_kind_name(kind));
+                fail(err, errlen, p->path, "'%s' is %s %s plugin, not %s %s", name, article((int)p->desc->kind),
+                     murk_kind_name((int)p->desc->kind), article(kind), murk_kind_name(kind));
                 return NULL;
             }
             return p;
@@ -256,7 +259,31 @@ const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *na
         r->loaded[r->nloaded++] = p;
         return p;
     }
-    int k = snprintf(err, errlen, "no %s%splugin '%s' (searched", kind ? murk_kind_name(kind) : "", kind ? " " : "", name);
+    /* nothing by that name: suggest the closest plugin file on the path */
+    char *cand[256];
+    size_t nc = 0;
+    for (size_t i = 0; i < r->ndirs; i++) {
+        DIR *d = opendir(r->dirs[i]);
+        struct dirent *e;
+        while (d && (e = readdir(d)) && nc < 256) {
+            size_t l = strlen(e->d_name);
+            if (l > 3 && strcmp(e->d_name + l - 3, ".so") == 0) {
+                cand[nc] = murk_strdup(e->d_name);
+                cand[nc++][l - 3] = 0;
+            }
+        }
+        if (d)
+            closedir(d);
+    }
+    const char *sug = murk_did_you_mean(name, (const char *const *)cand, nc);
+    int k;
+    if (sug)
+        k = snprintf(err, errlen, "no %s%splugin '%s' (did you mean '%s'?; searched", kind ? murk_kind_name(kind) : "",
+                     kind ? " " : "", name, sug);
+    else
+        k = snprintf(err, errlen, "no %s%splugin '%s' (searched", kind ? murk_kind_name(kind) : "", kind ? " " : "", name);
+    for (size_t i = 0; i < nc; i++)
+        free(cand[i]);
     for (size_t i = 0; i < r->ndirs && k > 0 && (size_t)k < errlen; i++)
         k += snprintf(err + k, errlen - (size_t)k, "%s %s", i ? "," : "", r->dirs[i]);
     if (k > 0 && (size_t)k < errlen)

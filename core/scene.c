@@ -27,8 +27,12 @@ static int read_number(const murk_ynode *n, const char *what, double *out, char 
     char *end = NULL;
     errno = 0;
     double v = strtod(n->str, &end);
-    if (!*n->str || *end || errno == ERANGE || !isfinite(v))
+    if (!*n->str || *end || isnan(v) || (n->str[0] == '0' && (n->str[1] == 'x' || n->str[1] == 'X')))
         return ERR(n, "%s must be a number, got '%s'", what, n->str);
+    if (isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
+        return ERR(n, "%s is too large, got '%s'", what, n->str);
+    if (errno == ERANGE) /* underflow: as good as 0 */
+        v = 0.0;
     *out = v;
     return 0;
 }
@@ -233,8 +237,15 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
         case MURK_PARAM_RGB:
             if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE)) {
                 murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
-                if (!t)
+                if (!t) { /* name the parameter after the location: "file:l:c: WHO: message" */
+                    char msg[2048];
+                    const char *rest = err;
+                    for (int colons = 0; colons < 3 && (rest = strchr(rest, ':')); colons++)
+                        rest++;
+                    snprintf(msg, sizeof msg, "%.*s %s:%s", rest ? (int)(rest - err) : 0, err, what, rest ? rest : err);
+                    snprintf(err, errlen, "%s", msg);
                     return -1;
+                }
                 s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
                 s->textures[s->ntextures++] = t;
                 v->tex = t;
@@ -733,8 +744,10 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     const murk_ynode *v = require(root, "murk", "the scene", err, errlen);
     long long ver;
-    if (!v || read_int(v, "murk (the format version)", 1, 1, &ver, err, errlen))
+    if (!v || read_int(v, "murk (the format version)", 0, 1e9, &ver, err, errlen))
         return -1;
+    if (ver != 1)
+        return ERR(v, "scene format version %lld is not supported (this murk reads version 1)", ver);
     const murk_ynode *c;
     if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
         return -1;

@@ -32,11 +32,12 @@ void murk_ynode_free(murk_ynode *n)
     free(n->keys);
     free(n->key_line);
     free(n->key_col);
+    free(n->key_file);
     free(n->str);
     free(n);
 }
 
-static void append(murk_ynode *parent, murk_ynode *child, char *key, int kl, int kc)
+static void append(murk_ynode *parent, murk_ynode *child, char *key, const char *kf, int kl, int kc)
 {
     size_t n = parent->n + 1;
     parent->items = murk_xrealloc(parent->items, n * sizeof *parent->items);
@@ -45,6 +46,8 @@ static void append(murk_ynode *parent, murk_ynode *child, char *key, int kl, int
         parent->keys = murk_xrealloc(parent->keys, n * sizeof *parent->keys);
         parent->key_line = murk_xrealloc(parent->key_line, n * sizeof(int));
         parent->key_col = murk_xrealloc(parent->key_col, n * sizeof(int));
+        parent->key_file = murk_xrealloc(parent->key_file, n * sizeof *parent->key_file);
+        parent->key_file[n - 1] = kf;
         parent->keys[n - 1] = key;
         parent->key_line[n - 1] = kl;
         parent->key_col[n - 1] = kc;
@@ -83,7 +86,7 @@ int murk_yerr_key(char *err, size_t errlen, const murk_ynode *map, size_t i, con
 {
     va_list ap;
     va_start(ap, fmt);
-    verr(err, errlen, map->file, map->key_line[i], map->key_col[i], fmt, ap);
+    verr(err, errlen, map->key_file ? map->key_file[i] : map->file, map->key_line[i], map->key_col[i], fmt, ap);
     va_end(ap);
     return -1;
 }
@@ -104,11 +107,23 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
         if (!yaml_parser_parse(p, &ev)) {
             int line = (int)p->problem_mark.line + 1, col = (int)p->problem_mark.column + 1;
             const char *prob = p->problem ? p->problem : "malformed YAML";
-            if (p->problem_mark.index < textlen && text[p->problem_mark.index] == '\t') {
-                /* libyaml says this of a tab used for indentation: say so plainly. */
+            int tab = 0;
+            if (p->error == YAML_READER_ERROR) {
+                /* encoding errors come as a byte offset, not a mark: count lines and characters */
+                size_t off = p->problem_offset < textlen ? p->problem_offset : textlen;
+                line = col = 1;
+                for (size_t i = 0; i < off; i++) {
+                    if (text[i] == '\n')
+                        line++, col = 1;
+                    else if ((text[i] & 0xC0) != 0x80)
+                        col++;
+                }
+            } else if (p->problem_mark.index < textlen && text[p->problem_mark.index] == '\t') {
+                /* libyaml says "cannot start any token" of a tab used for indentation: say so plainly */
                 prob = "tab character: YAML indentation must use spaces";
+                tab = 1;
             }
-            if (p->context)
+            if (p->context && !tab)
                 snprintf(err, errlen, "%s:%d:%d: %s %s", file, line, col, prob, p->context);
             else
                 snprintf(err, errlen, "%s:%d:%d: %s", file, line, col, prob);
@@ -150,7 +165,7 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
                 *root = top;
             } else {
                 murk_ynode *parent = stack[depth - 1];
-                append(parent, top, pending_key[depth - 1], pk_line[depth - 1], pk_col[depth - 1]);
+                append(parent, top, pending_key[depth - 1], file, pk_line[depth - 1], pk_col[depth - 1]);
                 pending_key[depth - 1] = NULL;
             }
             break;
@@ -202,10 +217,10 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
                         depth++;
                     }
                 } else if (parent->kind == MURK_Y_MAP) {
-                    append(parent, node, pending_key[depth - 1], pk_line[depth - 1], pk_col[depth - 1]);
+                    append(parent, node, pending_key[depth - 1], file, pk_line[depth - 1], pk_col[depth - 1]);
                     pending_key[depth - 1] = NULL;
                 } else {
-                    append(parent, node, NULL, 0, 0);
+                    append(parent, node, NULL, NULL, 0, 0);
                 }
             }
         }
@@ -274,11 +289,11 @@ int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errl
         }
         buf = murk_xrealloc(buf, cap *= 2);
     }
-    int bad = ferror(f);
+    int bad = ferror(f), saved = errno;
     fclose(f);
     if (bad) {
         free(buf);
-        snprintf(err, errlen, "%s: read error", path);
+        snprintf(err, errlen, "%s: cannot read: %s", path, strerror(saved));
         return -1;
     }
     if (memchr(buf, 0, n)) {
@@ -306,6 +321,8 @@ static void retag(murk_ynode *n, const char *file, int col_offset)
         retag(n->items[i], file, col_offset);
         if (n->key_col)
             n->key_col[i] += col_offset;
+        if (n->key_file)
+            n->key_file[i] = file;
     }
 }
 
@@ -385,7 +402,7 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
                     slot = &cur->items[i];
             if (!slot) {
                 murk_ynode *fresh = murk_ynode_new(dot ? MURK_Y_MAP : MURK_Y_SCALAR, SETFILE, 1, col);
-                append(cur, fresh, key, 1, col);
+                append(cur, fresh, key, SETFILE, 1, col);
                 slot = &cur->items[cur->n - 1];
             } else {
                 free(key);

@@ -19,6 +19,7 @@ struct murk_ynode {
     murk_ynode **items;
     char **keys;      /* MAP only */
     int *key_line, *key_col;
+    const char **key_file; /* where each key was written: the document's file, or "--set" */
 };
 
 typedef struct murk_ydoc {
