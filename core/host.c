@@ -49,7 +49,7 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
         h->p = murk_madd(sh->center, n, sh->radius); /* re-project onto the surface */
         h->ng = h->n = n;
         h->u = 0.5f + atan2f(n.z, n.x) * (0.5f * MURK_INV_PI);
-        h->v = acosf(fminf(1.0f, fmaxf(-1.0f, n.y))) * MURK_INV_PI;
+        h->v = acosf(murk_minf(1.0f, murk_maxf(-1.0f, n.y))) * MURK_INV_PI;
     } else {
         const uint32_t *ix = &sh->idx[3 * h->prim];
         float b1 = rh->hit.u, b2 = rh->hit.v, b0 = 1.0f - b1 - b2;
@@ -123,7 +123,7 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
 static float cone_one_minus_cos(float r, float d)
 {
     float sin2 = (r * r) / (d * d);
-    float cosm = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+    float cosm = sqrtf(murk_maxf(0.0f, 1.0f - sin2));
     return sin2 / (1.0f + cosm);
 }
 
@@ -155,15 +155,15 @@ static int host_sample_light(const murk_scene *s, murk_vec3 p, const float u[3],
         float omc = cone_one_minus_cos(l->radius, d);
         float one_minus_cos = u[1] * omc;
         float cost = 1.0f - one_minus_cos;
-        float sint = sqrtf(fmaxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+        float sint = sqrtf(murk_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
         float phi = 2.0f * MURK_PI * u[2];
         murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
         /* distance to the near intersection along dir */
         float bq = murk_dot(dir, dc);
         float disc = l->radius * l->radius - (d * d - bq * bq);
-        float dist = bq - sqrtf(fmaxf(0.0f, disc));
+        float dist = bq - sqrtf(murk_maxf(0.0f, disc));
         ls->wi = dir;
-        ls->dist = fmaxf(dist, 0.0f);
+        ls->dist = murk_maxf(dist, 0.0f);
         ls->le = l->le;
         ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
         return ls->pdf > 0.0f && isfinite(ls->pdf);

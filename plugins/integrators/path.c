@@ -52,8 +52,8 @@ static void path_destroy(void *self)
 /* Origin for a ray leaving p on the side of n that dir points to. */
 static murk_vec3 offset_origin(murk_vec3 p, murk_vec3 n, murk_vec3 dir)
 {
-    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
-    float eps = 1e-4f * fmaxf(1.0f, m);
+    float m = murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z)));
+    float eps = 1e-4f * murk_maxf(1.0f, m);
     return murk_madd(p, n, murk_dot(n, dir) >= 0.0f ? eps : -eps);
 }
 
@@ -143,7 +143,7 @@ static murk_rgb path_li(const void *self, const murk_scene *scene, const murk_ra
         prev_p = hit.p;
         depth++;
         if (depth > pt->rr_depth) {
-            float q = fminf(1.0f, murk_rgb_max(beta));
+            float q = murk_minf(1.0f, murk_rgb_max(beta));
             if (q < 0.05f)
                 q = 0.05f;
             if (murk_rng_float(rng) >= q)

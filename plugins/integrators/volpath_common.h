@@ -60,8 +60,8 @@ static void volpath_destroy(void *self)
 
 static murk_vec3 vp_offset(murk_vec3 p, murk_vec3 n, murk_vec3 dir)
 {
-    float m = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
-    float eps = 1e-4f * fmaxf(1.0f, m);
+    float m = murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z)));
+    float eps = 1e-4f * murk_maxf(1.0f, m);
     return murk_madd(p, n, murk_dot(n, dir) >= 0.0f ? eps : -eps);
 }
 
@@ -240,7 +240,7 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
     roulette:
         if (depth > v->rr_depth) {
             float mr = vp_mean(R);
-            float q = fminf(1.0f, fmaxf(fabsf(beta.c[0]), fmaxf(fabsf(beta.c[1]), fabsf(beta.c[2]))) / mr);
+            float q = murk_minf(1.0f, murk_maxf(fabsf(beta.c[0]), murk_maxf(fabsf(beta.c[1]), fabsf(beta.c[2]))) / mr);
             if (q < 0.05f)
                 q = 0.05f;
             if (murk_rng_float(rng) >= q)

@@ -73,7 +73,7 @@ static int diffuse_sample(const void *self, const murk_hit *hit, murk_vec3 wo, c
     /* Malley's method: uniform disk, lifted. */
     float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1];
     float x = r * cosf(phi), y = r * sinf(phi);
-    float z = sqrtf(fmaxf(0.0f, 1.0f - x * x - y * y));
+    float z = sqrtf(murk_maxf(0.0f, 1.0f - x * x - y * y));
     if (z <= 0.0f)
         return 0;
     s->wi = murk_v3(x, y, z);

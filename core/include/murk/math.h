@@ -18,6 +18,11 @@ typedef struct murk_ray {
     float tmin, tmax;
 } murk_ray;
 
+/* min/max that compile to one instruction (fmaxf/fminf are libm calls unless NaN semantics can be
+ * ignored). If b is NaN the result is NaN, so NaNs still reach the film's non-finite check. */
+static inline float murk_maxf(float a, float b) { return a > b ? a : b; }
+static inline float murk_minf(float a, float b) { return a < b ? a : b; }
+
 static inline murk_vec3 murk_v3(float x, float y, float z) { murk_vec3 v = {x, y, z}; return v; }
 static inline murk_vec3 murk_add(murk_vec3 a, murk_vec3 b) { return murk_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline murk_vec3 murk_sub(murk_vec3 a, murk_vec3 b) { return murk_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
@@ -60,7 +65,7 @@ static inline murk_rgb murk_rgb1(float v) { return murk_rgb3(v, v, v); }
 static inline murk_rgb murk_rgb_add(murk_rgb a, murk_rgb b) { return murk_rgb3(a.c[0] + b.c[0], a.c[1] + b.c[1], a.c[2] + b.c[2]); }
 static inline murk_rgb murk_rgb_mul(murk_rgb a, murk_rgb b) { return murk_rgb3(a.c[0] * b.c[0], a.c[1] * b.c[1], a.c[2] * b.c[2]); }
 static inline murk_rgb murk_rgb_scale(murk_rgb a, float s) { return murk_rgb3(a.c[0] * s, a.c[1] * s, a.c[2] * s); }
-static inline float murk_rgb_max(murk_rgb a) { return fmaxf(a.c[0], fmaxf(a.c[1], a.c[2])); }
+static inline float murk_rgb_max(murk_rgb a) { return murk_maxf(a.c[0], murk_maxf(a.c[1], a.c[2])); }
 static inline float murk_rgb_avg(murk_rgb a) { return (a.c[0] + a.c[1] + a.c[2]) * (1.0f / 3.0f); }
 static inline float murk_luminance(murk_rgb a) { return 0.2126f * a.c[0] + 0.7152f * a.c[1] + 0.0722f * a.c[2]; }
 static inline int murk_rgb_is_black(murk_rgb a) { return a.c[0] == 0.0f && a.c[1] == 0.0f && a.c[2] == 0.0f; }
