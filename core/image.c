@@ -281,7 +281,8 @@ static exr_result_t exr_write_pixels(exr_context_t ctx, int part, const float *r
 
 /* Everything between opening the temporary and closing it. *step and *what describe a failure. */
 static exr_result_t exr_write_file(exr_io *io, const char *tmp, const float *rgb, int w, int h,
-                                   const murk_kv *meta, int nmeta, const char **step, const char **what)
+                                   const murk_kv *meta, int nmeta, exr_compression_t comp, const char **step,
+                                   const char **what)
 {
     static const char *const names[3] = {"B", "G", "R"};
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -300,7 +301,7 @@ static exr_result_t exr_write_file(exr_io *io, const char *tmp, const float *rgb
     *step = "defining the image";
     rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
     if (rv == EXR_ERR_SUCCESS)
-        rv = exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP);
+        rv = exr_initialize_required_attr_simple(ctx, part, w, h, comp);
     for (int c = 0; c < 3 && rv == EXR_ERR_SUCCESS; c++)
         rv = exr_add_channel(ctx, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     for (int i = 0; i < nmeta && rv == EXR_ERR_SUCCESS; i++) {
@@ -328,6 +329,41 @@ static exr_result_t exr_write_file(exr_io *io, const char *tmp, const float *rgb
     return rv != EXR_ERR_SUCCESS ? rv : frv;
 }
 
+/* Writes the whole file to tmp with the given compression; 0, or -1 with err. */
+static int exr_write_tmp(const char *path, const char *tmp, const float *rgb, int w, int h, const murk_kv *meta,
+                         int nmeta, exr_compression_t comp, char *err, size_t errlen)
+{
+    exr_io io;
+    memset(&io, 0, sizeof io);
+    io.fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (io.fd < 0)
+        return fail(err, errlen, "%s: cannot create %s: %s", path, tmp, strerror(errno));
+    const char *step = "", *what = NULL;
+    exr_result_t rv = exr_write_file(&io, tmp, rgb, w, h, meta, nmeta, comp, &step, &what);
+    if (rv != EXR_ERR_SUCCESS) {
+        const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
+        if (what)
+            fail(err, errlen, "%s: EXR error %s '%.64s': %s", path, step, what, why);
+        else
+            fail(err, errlen, "%s: EXR error %s: %s", path, step, why);
+        close(io.fd);
+        return -1;
+    }
+    return sync_close(io.fd, tmp, path, err, errlen);
+}
+
+/* 1 if the file at tmp holds exactly these pixels. */
+static int exr_verify(const char *tmp, const float *rgb, int w, int h)
+{
+    murk_image img;
+    char err[256];
+    if (murk_exr_read(tmp, &img, err, sizeof err) != 0)
+        return 0;
+    int same = img.w == w && img.h == h && memcmp(img.rgb, rgb, 3 * sizeof(float) * (size_t)w * (size_t)h) == 0;
+    murk_image_free(&img);
+    return same;
+}
+
 int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_kv *meta, int nmeta,
                    char *err, size_t errlen)
 {
@@ -336,28 +372,14 @@ int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_
     char *tmp = tmp_name(path);
     if (!tmp)
         return fail(err, errlen, "%s: out of memory", path);
-    exr_io io;
-    memset(&io, 0, sizeof io);
-    io.fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (io.fd < 0) {
-        fail(err, errlen, "%s: cannot create %s: %s", path, tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
-    const char *step = "", *what = NULL;
-    exr_result_t rv = exr_write_file(&io, tmp, rgb, w, h, meta, nmeta, &step, &what);
-    int rc;
-    if (rv != EXR_ERR_SUCCESS) {
-        const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
-        if (what)
-            fail(err, errlen, "%s: EXR error %s '%.64s': %s", path, step, what, why);
-        else
-            fail(err, errlen, "%s: EXR error %s: %s", path, step, why);
-        close(io.fd);
-        rc = -1;
-    } else {
-        rc = sync_close(io.fd, tmp, path, err, errlen);
-    }
+    /* ZIP, read back and checked bit for bit: OpenEXRCore 3.1's ZIP encoder can store a chunk whose
+     * zlib output is as large as its input in a form its decoder misreads (openexr issue 2306). If
+     * the check fails, the file is written again uncompressed. */
+    int rc = exr_write_tmp(path, tmp, rgb, w, h, meta, nmeta, EXR_COMPRESSION_ZIP, err, errlen);
+    if (rc == 0 && !exr_verify(tmp, rgb, w, h))
+        rc = exr_write_tmp(path, tmp, rgb, w, h, meta, nmeta, EXR_COMPRESSION_NONE, err, errlen);
+    if (rc == 0 && !exr_verify(tmp, rgb, w, h))
+        rc = fail(err, errlen, "%s: the EXR written does not read back identically", path);
     rc = commit_tmp(rc, tmp, path, err, errlen);
     free(tmp);
     return rc;

@@ -8,6 +8,7 @@
 #include "testutil.h"
 
 #include "image.h"
+#include "murk/math.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -813,6 +814,32 @@ static void test_png_write_failures(void **state)
     assert_int_equal(count_entries(dir), 2);
 }
 
+/* A 32x16 image whose single ZIP chunk deflates to exactly its own size: OpenEXRCore 3.1.5 stores such
+ * a chunk in a form its own decoder misreads (openexr issue 2306). Found by search; murk_exr_write must
+ * notice (it reads every file back) and fall back to an uncompressed file. */
+static void test_exr_zip_equal_size_chunk(void **state)
+{
+    (void)state;
+    enum { W = 32, H = 16 };
+    float px[3 * W * H];
+    murk_rng r;
+    murk_rng_seed(&r, 5175, 7, 9);
+    for (int i = 0; i < 3 * W * H; i++) { /* 15 random mantissa bits in [0.25, 0.75) */
+        float v = 0.25f + 0.5f * murk_rng_float(&r);
+        uint32_t u;
+        memcpy(&u, &v, 4);
+        u &= ~((1u << 8) - 1u);
+        memcpy(&px[i], &u, 4);
+    }
+    char path[512], err[512];
+    snprintf(path, sizeof path, "%s/zip_equal.exr", tmp_dir());
+    assert_int_equal(murk_exr_write(path, px, W, H, NULL, 0, err, sizeof err), 0);
+    murk_image img;
+    assert_int_equal(murk_exr_read(path, &img, err, sizeof err), 0);
+    assert_memory_equal(img.rgb, px, sizeof px);
+    murk_image_free(&img);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -835,6 +862,7 @@ int main(void)
         cmocka_unit_test(test_png_interlaced),
         cmocka_unit_test(test_png_broken_files),
         cmocka_unit_test(test_png_write_failures),
+        cmocka_unit_test(test_exr_zip_equal_size_chunk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
