@@ -1,5 +1,5 @@
-/* volpath_common.h — the volumetric path tracer shared by the volpath and volpath_nee plugins (each
- * plugin is one .c file that includes this and sets `nee`). Not a public header.
+/* volpath_common.h — the path tracer shared by the path, volpath and volpath_nee plugins (each plugin
+ * is one .c file that includes this and chooses `nee` and `media`). Not a public header.
  *
  * Paths carry beta (RGB weight) and R (RGB pdf ratios, see murk/medium.h); a path that reaches
  * emission L adds beta * L / mean(R). A hero channel is chosen uniformly per path for the trackers
@@ -11,7 +11,8 @@
  * transmittance to it with the media's transmittance() (ratio tracking) through any boundaries, and
  * weights the two strategies with the power heuristic on their directional pdfs (unbiased: the
  * weights depend on the direction only and sum to 1). With nee = 0 emission is found by BSDF / phase
- * sampling alone — a slower, independent estimator of the same image. Russian roulette after
+ * sampling alone — a slower, independent estimator of the same image. With media = 0 (the surface
+ * `path` integrator) media are ignored and boundaries passed straight through. Russian roulette after
  * rr_depth bounces on the path's largest channel weight, survivors divided by the survival
  * probability. */
 #ifndef MURK_VOLPATH_COMMON_H
@@ -73,6 +74,17 @@ static float vp_power(float a, float b)
 
 static float vp_mean(murk_rgb r) { return (r.c[0] + r.c[1] + r.c[2]) * (1.0f / 3.0f); }
 
+/* 1 if nothing but index-matched boundaries lies between p and the light point at distance dist. */
+static float vp_unoccluded(const volpath *v, const murk_scene *scene, murk_vec3 p, murk_vec3 n, murk_vec3 w, float dist)
+{
+    murk_ray r;
+    r.o = vp_offset(p, n, w);
+    r.d = w;
+    r.tmin = 0.0f;
+    r.tmax = dist * (1.0f - 1e-3f);
+    return v->host->occluded(scene, &r) ? 0.0f : 1.0f;
+}
+
 /* Transmittance from p along unit w to the light point at distance dist, starting in medium m and
  * crossing index-matched boundaries; 0 if a surface with a material blocks the way. offset_n: the
  * normal to offset a surface point along (a zero vector for a point inside a medium). */
@@ -112,7 +124,7 @@ static murk_rgb vp_transmittance(const volpath *v, const murk_scene *scene, murk
 }
 
 static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const murk_ray *camera_ray, murk_rng *rng,
-                                int nee)
+                                int nee, int media)
 {
     const murk_host *h = v->host;
     murk_rgb L = murk_rgb1(0.0f), beta = murk_rgb1(1.0f), R = murk_rgb1(1.0f);
@@ -120,7 +132,7 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
     ctx.hero = (int)(murk_rng_float(rng) * 3.0f);
     if (ctx.hero > 2)
         ctx.hero = 2;
-    const murk_medium *medium = h->camera_medium(scene);
+    const murk_medium *medium = media ? h->camera_medium(scene) : NULL;
     murk_ray ray = *camera_ray;
     float prev_pdf = 0.0f;
     int prev_delta = 1, crossings = 0, depth = 0;
@@ -180,7 +192,8 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
             if (!hit.material) { /* index-matched boundary: change medium, go straight on */
                 if (++crossings > 1000)
                     break;
-                medium = murk_dot(ray.d, hit.ng) < 0.0f ? hit.interior : hit.exterior;
+                if (media)
+                    medium = murk_dot(ray.d, hit.ng) < 0.0f ? hit.interior : hit.exterior;
                 ray.o = vp_offset(hit.p, hit.ng, ray.d);
                 ray.tmin = 0.0f;
                 ray.tmax = INFINITY;
@@ -211,7 +224,8 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
                     murk_vec3 wi = murk_to_local(ls.wi, t, b, n);
                     murk_rgb f = m->vt->eval(m->self, &hit, wo, wi);
                     if (!murk_rgb_is_black(f)) {
-                        murk_rgb T = vp_transmittance(v, scene, hit.p, ng, ls.wi, ls.dist, medium, &ctx, rng);
+                        murk_rgb T = media ? vp_transmittance(v, scene, hit.p, ng, ls.wi, ls.dist, medium, &ctx, rng)
+                                           : murk_rgb1(vp_unoccluded(v, scene, hit.p, ng, ls.wi, ls.dist));
                         if (!murk_rgb_is_black(T)) {
                             float w = vp_power(ls.pdf, m->vt->pdf(m->self, &hit, wo, wi));
                             float k = fabsf(wi.z) * w / ls.pdf / vp_mean(R);

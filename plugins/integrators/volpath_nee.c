@@ -14,7 +14,7 @@
 
 static murk_rgb li(const void *self, const murk_scene *scene, const murk_ray *ray, murk_rng *rng)
 {
-    return volpath_li_impl(self, scene, ray, rng, 1);
+    return volpath_li_impl(self, scene, ray, rng, 1, 1);
 }
 
 static const murk_integrator_vt vt = {sizeof(murk_integrator_vt), volpath_create, volpath_destroy, li};

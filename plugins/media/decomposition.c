@@ -21,8 +21,6 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#include <stdio.h>
-
 enum { P_CONTROL, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
@@ -31,27 +29,19 @@ static const murk_param params[P_COUNT] = {
 };
 
 typedef struct decomposition {
-    const murk_host *host;
-    const murk_medium_data *d;
-    murk_rgb sigma_t;
-    float smax, savg, control;
+    murk_tracker base;
+    float savg, control;
+    int grey;
 } decomposition;
 
 static int decomposition_create(const murk_host *host, const murk_medium_data *data, const murk_value *p,
                                 void **self, char *err, size_t errlen)
 {
-    if (host->size < sizeof(murk_host)) {
-        snprintf(err, errlen, "this murk's host table lacks the media services");
-        return -1;
-    }
-    decomposition *m = host->alloc(sizeof *m);
+    decomposition *m = murk_tracker_new(host, data, sizeof *m, err, errlen);
     if (!m)
         return -1;
-    m->host = host;
-    m->d = data;
-    m->sigma_t = murk_sigma_t(data);
-    m->smax = murk_rgb_max(m->sigma_t);
-    m->savg = murk_rgb_avg(m->sigma_t);
+    m->savg = murk_rgb_avg(m->base.sigma_t);
+    m->grey = m->base.sigma_t.c[0] == m->base.sigma_t.c[1] && m->base.sigma_t.c[1] == m->base.sigma_t.c[2];
     m->control = (float)p[P_CONTROL].f[0];
     if (m->control > 1.0f)
         host->log(MURK_LOG_WARN,
@@ -61,20 +51,13 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     return 0;
 }
 
-static void decomposition_destroy(void *self)
-{
-    decomposition *m = self;
-    if (m)
-        m->host->free(m);
-}
-
 /* Weights channel k by the control process having been sampled at the average rate over length s. */
 static void control_tilt(const decomposition *m, float c, float s, murk_rgb *w)
 {
     if (c <= 0.0f || s <= 0.0f)
         return;
     for (int k = 0; k < 3; k++)
-        w->c[k] *= expf(-c * (m->sigma_t.c[k] - m->savg) * s);
+        w->c[k] *= expf(-c * (m->base.sigma_t.c[k] - m->savg) * s);
 }
 
 static int decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
@@ -82,20 +65,18 @@ static int decomposition_sample(const void *self, const murk_ray *ray, const mur
 {
     (void)ctx;
     const decomposition *m = self;
-    const murk_host *h = m->host;
-    ev->scattered = 0;
-    ev->t = ray->tmax;
-    ev->weight = murk_rgb1(1.0f);
-    ev->pdf = murk_rgb1(1.0f);
-    if (!(m->smax > 0.0f))
+    const murk_host *h = m->base.host;
+    const murk_medium_data *d = m->base.d;
+    murk_event_init(ev, ray);
+    if (!(m->base.smax > 0.0f))
         return 0;
     murk_majorant_walk w;
-    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
+    h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin;
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         float c = m->control * dmin;
         float rate_c = c * m->savg; /* control events, sampled at the channel-average rate */
-        float mu_r = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * m->smax;
+        float mu_r = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * m->base.smax;
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
         float tc = rate_c > 0.0f ? ta + murk_sample_exp(rng, rate_c) : INFINITY;
@@ -110,29 +91,29 @@ static int decomposition_sample(const void *self, const murk_ray *ray, const mur
             if (tc <= tr) { /* control collision: always real */
                 control_tilt(m, c, tc - ta, &ev->weight);
                 for (int k = 0; k < 3; k++) /* (sigma_c,k / mean sigma_c) * albedo_k */
-                    ev->weight.c[k] *= m->d->sigma_s.c[k] / m->savg;
+                    ev->weight.c[k] *= d->sigma_s.c[k] / m->savg;
                 ev->scattered = 1;
                 ev->t = tc;
                 return 1;
             }
             t = tr;
-            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t)) - c; /* residual density */
+            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t)) - c; /* residual density */
             if (dens < 0.0f)
                 h->warn_once("medium '%s': decomposition control exceeds the local density (negative residual): "
-                             "weighted residual collisions (unbiased, noisier)", m->d->name);
+                             "weighted residual collisions (unbiased, noisier)", d->name);
             float a = dens * m->savg / mu_r;
             float q = murk_real_prob(a, 1.0f - a);
             if (murk_rng_float(rng) < q) {
                 control_tilt(m, c, t - ta, &ev->weight);
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (mu_r * q);
+                    ev->weight.c[k] *= dens * d->sigma_s.c[k] / (mu_r * q);
                 ev->scattered = 1;
                 ev->t = t;
                 return 1;
             }
-            if (dens < 0.0f || a > 1.0f || m->sigma_t.c[0] != m->sigma_t.c[1] || m->sigma_t.c[1] != m->sigma_t.c[2])
+            if (dens < 0.0f || a > 1.0f || !m->grey)
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= (1.0f - dens * m->sigma_t.c[k] / mu_r) / (1.0f - q);
+                    ev->weight.c[k] *= (1.0f - dens * m->base.sigma_t.c[k] / mu_r) / (1.0f - q);
         }
     }
     return 0;
@@ -143,10 +124,10 @@ static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ra
 {
     (void)ctx;
     const decomposition *m = self;
-    return murk_ratio_tracking(m->host, m->d, ray, m->control, rng);
+    return murk_ratio_tracking(m->base.host, m->base.d, ray, m->control, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), decomposition_create, decomposition_destroy,
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), decomposition_create, murk_tracker_free,
                                   decomposition_sample, decomposition_transmittance};
 
 static const murk_plugin_desc desc = {

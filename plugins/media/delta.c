@@ -15,13 +15,8 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#include <stdio.h>
-
 typedef struct delta {
-    const murk_host *host;
-    const murk_medium_data *d;
-    murk_rgb sigma_t;
-    float smax;
+    murk_tracker base;
     int grey;
 } delta;
 
@@ -29,18 +24,10 @@ static int delta_create(const murk_host *host, const murk_medium_data *data, con
                         char *err, size_t errlen)
 {
     (void)params;
-    if (host->size < sizeof(murk_host)) {
-        snprintf(err, errlen, "this murk's host table lacks the media services");
-        return -1;
-    }
-    delta *m = host->alloc(sizeof *m);
+    delta *m = murk_tracker_new(host, data, sizeof *m, err, errlen);
     if (!m)
         return -1;
-    m->host = host;
-    m->d = data;
-    m->sigma_t = murk_sigma_t(data);
-    m->smax = murk_rgb_max(m->sigma_t);
-    m->grey = m->sigma_t.c[0] == m->sigma_t.c[1] && m->sigma_t.c[1] == m->sigma_t.c[2];
+    m->grey = m->base.sigma_t.c[0] == m->base.sigma_t.c[1] && m->base.sigma_t.c[1] == m->base.sigma_t.c[2];
     if (!m->grey)
         host->log(MURK_LOG_INFO,
                   "medium '%s': delta tracking with chromatic extinction: collisions use the channel average with "
@@ -49,53 +36,34 @@ static int delta_create(const murk_host *host, const murk_medium_data *data, con
     return 0;
 }
 
-static void delta_destroy(void *self)
-{
-    delta *m = self;
-    if (m)
-        m->host->free(m);
-}
-
 static int delta_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                         murk_medium_event *ev)
 {
     (void)ctx;
     const delta *m = self;
-    const murk_host *h = m->host;
-    ev->scattered = 0;
-    ev->t = ray->tmax;
-    ev->weight = murk_rgb1(1.0f);
-    ev->pdf = murk_rgb1(1.0f);
-    if (!(m->smax > 0.0f))
+    const murk_medium_data *d = m->base.d;
+    murk_event_init(ev, ray);
+    if (!(m->base.smax > 0.0f))
         return 0;
-    murk_majorant_walk w;
-    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
-    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
-        float mu = dmax * m->smax;
-        if (!(mu > 0.0f))
-            continue;
-        for (float t = ta;;) {
-            t += murk_sample_exp(rng, mu);
-            if (!(t < tb))
-                break;
-            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t));
-            float a = dens * murk_rgb_avg(m->sigma_t) / mu; /* real share of the collision */
-            if (a > 1.0f)
-                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): delta tracking "
-                             "switches to weighted collisions (unbiased, noisier)", m->d->name);
-            float q = murk_real_prob(a, 1.0f - a);
-            if (murk_rng_float(rng) < q) {
-                for (int k = 0; k < 3; k++) /* sigma_s,c(x) / (mu q) */
-                    ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (mu * q);
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            if (!m->grey || a > 1.0f)
-                for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= (mu - dens * m->sigma_t.c[k]) / (mu * (1.0f - q));
+    murk_collisions c;
+    murk_collisions_init(&c, &m->base, ray, m->base.smax);
+    float t, dens;
+    while (murk_collisions_next(&c, rng, &t, &dens)) {
+        float a = dens * murk_rgb_avg(m->base.sigma_t) / c.mu; /* real share of the collision */
+        if (a > 1.0f)
+            m->base.host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): delta "
+                                    "tracking switches to weighted collisions (unbiased, noisier)", d->name);
+        float q = murk_real_prob(a, 1.0f - a);
+        if (murk_rng_float(rng) < q) {
+            for (int k = 0; k < 3; k++) /* sigma_s,k(x) / (mu q): the albedo for grey extinction */
+                ev->weight.c[k] *= dens * d->sigma_s.c[k] / (c.mu * q);
+            ev->scattered = 1;
+            ev->t = t;
+            return 1;
         }
+        if (!m->grey || a > 1.0f)
+            for (int k = 0; k < 3; k++)
+                ev->weight.c[k] *= (c.mu - dens * m->base.sigma_t.c[k]) / (c.mu * (1.0f - q));
     }
     return 0;
 }
@@ -104,10 +72,10 @@ static murk_rgb delta_transmittance(const void *self, const murk_ray *ray, const
 {
     (void)ctx;
     const delta *m = self;
-    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
+    return murk_ratio_tracking(m->base.host, m->base.d, ray, 0.0f, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), delta_create, delta_destroy, delta_sample,
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), delta_create, murk_tracker_free, delta_sample,
                                   delta_transmittance};
 
 static const murk_plugin_desc desc = {

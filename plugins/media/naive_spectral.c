@@ -14,92 +14,54 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#include <stdio.h>
-
-typedef struct naive {
-    const murk_host *host;
-    const murk_medium_data *d;
-    murk_rgb sigma_t;
-} naive;
-
 static int naive_create(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
                         char *err, size_t errlen)
 {
     (void)params;
-    if (host->size < sizeof(murk_host)) {
-        snprintf(err, errlen, "this murk's host table lacks the media services");
-        return -1;
-    }
-    naive *m = host->alloc(sizeof *m);
-    if (!m)
-        return -1;
-    m->host = host;
-    m->d = data;
-    m->sigma_t = murk_sigma_t(data);
-    *self = m;
-    return 0;
-}
-
-static void naive_destroy(void *self)
-{
-    naive *m = self;
-    if (m)
-        m->host->free(m);
+    return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
 }
 
 static int naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                         murk_medium_event *ev)
 {
-    const naive *m = self;
-    const murk_host *h = m->host;
+    const murk_tracker *m = self;
     int hero = ctx->hero;
     float st = m->sigma_t.c[hero];
-    ev->scattered = 0;
-    ev->t = ray->tmax;
-    ev->weight = murk_rgb1(0.0f);
+    murk_event_init(ev, ray);
+    ev->weight = murk_rgb1(0.0f); /* only the hero channel carries this path */
     ev->weight.c[hero] = 1.0f;
     ev->pdf = ev->weight;
     if (!(st > 0.0f))
         return 0;
-    murk_majorant_walk w;
-    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
-    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
-        float mu = dmax * st;
-        if (!(mu > 0.0f))
-            continue;
-        for (float t = ta;;) {
-            t += murk_sample_exp(rng, mu);
-            if (!(t < tb))
-                break;
-            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t));
-            float a = dens * st / mu;
-            if (a > 1.0f)
-                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): per-channel delta "
-                             "tracking uses weighted collisions (unbiased, noisier)", m->d->name);
-            float q = murk_real_prob(a, 1.0f - a);
-            if (murk_rng_float(rng) < q) {
-                ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (mu * q);
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            if (a > 1.0f)
-                ev->weight.c[hero] *= (1.0f - a) / (1.0f - q);
+    murk_collisions c;
+    murk_collisions_init(&c, m, ray, st); /* the hero channel's own majorant */
+    float t, dens;
+    while (murk_collisions_next(&c, rng, &t, &dens)) {
+        float a = dens * st / c.mu;
+        if (a > 1.0f)
+            m->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): per-channel delta "
+                               "tracking uses weighted collisions (unbiased, noisier)", m->d->name);
+        float q = murk_real_prob(a, 1.0f - a);
+        if (murk_rng_float(rng) < q) {
+            ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (c.mu * q);
+            ev->scattered = 1;
+            ev->t = t;
+            return 1;
         }
+        if (a > 1.0f)
+            ev->weight.c[hero] *= (1.0f - a) / (1.0f - q);
     }
     return 0;
 }
 
 static murk_rgb naive_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
 {
-    const naive *m = self;
-    murk_rgb T = murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
-    (void)ctx; /* all channels are estimated; only the hero's carries weight in the path */
-    return T;
+    (void)ctx; /* every channel is estimated; only the hero's carries weight in the path */
+    const murk_tracker *m = self;
+    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), naive_create, naive_destroy, naive_sample,
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), naive_create, murk_tracker_free, naive_sample,
                                   naive_transmittance};
 
 static const murk_plugin_desc desc = {

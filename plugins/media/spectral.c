@@ -18,8 +18,6 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#include <stdio.h>
-
 enum { P_PROBABILITIES, P_COUNT };
 enum { PROB_MAX, PROB_AVERAGE, PROB_HISTORY };
 
@@ -29,37 +27,19 @@ static const murk_param params[P_COUNT] = {
 };
 
 typedef struct spectral {
-    const murk_host *host;
-    const murk_medium_data *d;
-    murk_rgb sigma_t;
-    float smax;
+    murk_tracker base;
     int scheme;
 } spectral;
 
 static int spectral_create(const murk_host *host, const murk_medium_data *data, const murk_value *p, void **self,
                            char *err, size_t errlen)
 {
-    if (host->size < sizeof(murk_host)) {
-        snprintf(err, errlen, "this murk's host table lacks the media services");
-        return -1;
-    }
-    spectral *m = host->alloc(sizeof *m);
+    spectral *m = murk_tracker_new(host, data, sizeof *m, err, errlen);
     if (!m)
         return -1;
-    m->host = host;
-    m->d = data;
-    m->sigma_t = murk_sigma_t(data);
-    m->smax = murk_rgb_max(m->sigma_t);
     m->scheme = p[P_PROBABILITIES].choice;
     *self = m;
     return 0;
-}
-
-static void spectral_destroy(void *self)
-{
-    spectral *m = self;
-    if (m)
-        m->host->free(m);
 }
 
 static float pick(int scheme, const float x[3], const float w[3])
@@ -75,64 +55,43 @@ static int spectral_sample(const void *self, const murk_ray *ray, const murk_pat
                            murk_medium_event *ev)
 {
     const spectral *m = self;
-    const murk_host *h = m->host;
-    ev->scattered = 0;
-    ev->t = ray->tmax;
-    ev->weight = murk_rgb1(1.0f);
-    ev->pdf = murk_rgb1(1.0f);
-    if (!(m->smax > 0.0f))
+    const murk_medium_data *d = m->base.d;
+    murk_event_init(ev, ray);
+    if (!(m->base.smax > 0.0f))
         return 0;
-    murk_majorant_walk w;
-    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
-    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
-        float mu = dmax * m->smax;
-        if (!(mu > 0.0f))
-            continue;
-        for (float t = ta;;) {
-            t += murk_sample_exp(rng, mu);
-            if (!(t < tb))
-                break;
-            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t));
-            float sa[3], ss[3], sn[3], hist[3];
-            int neg = 0;
-            for (int k = 0; k < 3; k++) {
-                sa[k] = dens * m->d->sigma_a.c[k];
-                ss[k] = dens * m->d->sigma_s.c[k];
-                sn[k] = mu - dens * m->sigma_t.c[k];
-                neg |= sn[k] < 0.0f;
-                hist[k] = ctx->beta.c[k] * ev->weight.c[k];
-            }
-            if (neg)
-                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral tracking "
-                             "uses negative null weights (unbiased, noisier)", m->d->name);
-            float pa = pick(m->scheme, sa, hist), ps = pick(m->scheme, ss, hist), pn = pick(m->scheme, sn, hist);
-            float sum = pa + ps + pn;
-            if (!(sum > 0.0f)) { /* the path carries no weight in any channel */
-                ev->weight = murk_rgb1(0.0f);
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            float u = murk_rng_float(rng) * sum;
-            if (u < pa) { /* absorbed: no emission in murk's media, the path ends */
-                ev->weight = murk_rgb1(0.0f);
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            if (u < pa + ps) {
-                float P = ps / sum;
-                for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= ss[k] / (mu * P);
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            float P = pn / sum;
-            for (int k = 0; k < 3; k++)
-                ev->weight.c[k] *= sn[k] / (mu * P);
+    murk_collisions c;
+    murk_collisions_init(&c, &m->base, ray, m->base.smax);
+    float t, dens;
+    while (murk_collisions_next(&c, rng, &t, &dens)) {
+        float sa[3], ss[3], sn[3], hist[3];
+        int neg = 0;
+        for (int k = 0; k < 3; k++) {
+            sa[k] = dens * d->sigma_a.c[k];
+            ss[k] = dens * d->sigma_s.c[k];
+            sn[k] = c.mu - dens * m->base.sigma_t.c[k];
+            neg |= sn[k] < 0.0f;
+            hist[k] = ctx->beta.c[k] * ev->weight.c[k];
         }
+        if (neg)
+            m->base.host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral "
+                                    "tracking uses negative null weights (unbiased, noisier)", d->name);
+        float pa = pick(m->scheme, sa, hist), ps = pick(m->scheme, ss, hist), pn = pick(m->scheme, sn, hist);
+        float sum = pa + ps + pn, u = murk_rng_float(rng) * sum;
+        if (!(sum > 0.0f) || u < pa) { /* absorbed (or no weight left in any channel): the path ends */
+            ev->weight = murk_rgb1(0.0f);
+            ev->scattered = 1;
+            ev->t = t;
+            return 1;
+        }
+        if (u < pa + ps) {
+            for (int k = 0; k < 3; k++)
+                ev->weight.c[k] *= ss[k] * sum / (c.mu * ps);
+            ev->scattered = 1;
+            ev->t = t;
+            return 1;
+        }
+        for (int k = 0; k < 3; k++)
+            ev->weight.c[k] *= sn[k] * sum / (c.mu * pn);
     }
     return 0;
 }
@@ -142,10 +101,10 @@ static murk_rgb spectral_transmittance(const void *self, const murk_ray *ray, co
 {
     (void)ctx;
     const spectral *m = self;
-    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
+    return murk_ratio_tracking(m->base.host, m->base.d, ray, 0.0f, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), spectral_create, spectral_destroy, spectral_sample,
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), spectral_create, murk_tracker_free, spectral_sample,
                                   spectral_transmittance};
 
 static const murk_plugin_desc desc = {

@@ -19,86 +19,45 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#include <stdio.h>
-
-typedef struct smis {
-    const murk_host *host;
-    const murk_medium_data *d;
-    murk_rgb sigma_t;
-    float smax;
-} smis;
-
 static int smis_create(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
                        char *err, size_t errlen)
 {
     (void)params;
-    if (host->size < sizeof(murk_host)) {
-        snprintf(err, errlen, "this murk's host table lacks the media services");
-        return -1;
-    }
-    smis *m = host->alloc(sizeof *m);
-    if (!m)
-        return -1;
-    m->host = host;
-    m->d = data;
-    m->sigma_t = murk_sigma_t(data);
-    m->smax = murk_rgb_max(m->sigma_t);
-    *self = m;
-    return 0;
-}
-
-static void smis_destroy(void *self)
-{
-    smis *m = self;
-    if (m)
-        m->host->free(m);
+    return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
 }
 
 static int smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                        murk_medium_event *ev)
 {
-    const smis *m = self;
-    const murk_host *h = m->host;
+    const murk_tracker *m = self;
     int hero = ctx->hero;
-    ev->scattered = 0;
-    ev->t = ray->tmax;
-    ev->weight = murk_rgb1(1.0f);
-    ev->pdf = murk_rgb1(1.0f);
+    murk_event_init(ev, ray);
     if (!(m->smax > 0.0f))
         return 0;
-    murk_majorant_walk w;
-    h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
-    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
-        float mu = dmax * m->smax;
-        if (!(mu > 0.0f))
-            continue;
-        for (float t = ta;;) {
-            t += murk_sample_exp(rng, mu);
-            if (!(t < tb))
-                break;
-            float dens = h->density(m->d->density, murk_madd(ray->o, ray->d, t));
-            float a[3], q[3];
+    murk_collisions c;
+    murk_collisions_init(&c, m, ray, m->smax); /* one majorant for every channel */
+    float t, dens;
+    while (murk_collisions_next(&c, rng, &t, &dens)) {
+        float a[3], q[3];
+        for (int k = 0; k < 3; k++) {
+            a[k] = dens * m->sigma_t.c[k] / c.mu;
+            q[k] = murk_real_prob(a[k], 1.0f - a[k]);
+        }
+        if (a[hero] > 1.0f)
+            m->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral MIS uses "
+                               "weighted collisions (unbiased, noisier)", m->d->name);
+        if (murk_rng_float(rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
-                a[k] = dens * m->sigma_t.c[k] / mu;
-                q[k] = murk_real_prob(a[k], 1.0f - a[k]);
+                ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
+                ev->pdf.c[k] *= q[k] / q[hero];
             }
-            if (a[hero] > 1.0f)
-                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral MIS uses "
-                             "weighted collisions (unbiased, noisier)", m->d->name);
-            if (murk_rng_float(rng) < q[hero]) {
-                for (int k = 0; k < 3; k++) {
-                    ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (mu * q[hero]);
-                    ev->pdf.c[k] *= q[k] / q[hero];
-                }
-                ev->scattered = 1;
-                ev->t = t;
-                return 1;
-            }
-            for (int k = 0; k < 3; k++) {
-                ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
-                ev->pdf.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
-            }
+            ev->scattered = 1;
+            ev->t = t;
+            return 1;
+        }
+        for (int k = 0; k < 3; k++) {
+            ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
+            ev->pdf.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
         }
     }
     return 0;
@@ -107,11 +66,11 @@ static int smis_sample(const void *self, const murk_ray *ray, const murk_path_ct
 static murk_rgb smis_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
 {
     (void)ctx;
-    const smis *m = self;
+    const murk_tracker *m = self;
     return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), smis_create, smis_destroy, smis_sample,
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), smis_create, murk_tracker_free, smis_sample,
                                   smis_transmittance};
 
 static const murk_plugin_desc desc = {

@@ -4,7 +4,54 @@
 #ifndef MURK_TRACKING_H
 #define MURK_TRACKING_H
 
+#include <stdio.h>
+
 #include "murk/medium.h"
+
+/* What every tracker keeps; put it first in a tracker's own struct. */
+typedef struct murk_tracker {
+    const murk_host *host;
+    const murk_medium_data *d;
+    murk_rgb sigma_t; /* extinction per unit density */
+    float smax;       /* its largest channel */
+} murk_tracker;
+
+/* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
+ * when the host lacks the media services or memory runs out. */
+static inline void *murk_tracker_new(const murk_host *host, const murk_medium_data *d, size_t size, char *err,
+                                     size_t errlen)
+{
+    if (host->size < sizeof(murk_host) || size < sizeof(murk_tracker)) {
+        snprintf(err, errlen, "this murk's host table lacks the media services");
+        return NULL;
+    }
+    murk_tracker *t = host->alloc(size);
+    if (!t) {
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    t->host = host;
+    t->d = d;
+    t->sigma_t = murk_rgb_add(d->sigma_a, d->sigma_s);
+    t->smax = murk_rgb_max(t->sigma_t);
+    return t;
+}
+
+static inline void murk_tracker_free(void *self)
+{
+    murk_tracker *t = self;
+    if (t)
+        t->host->free(t);
+}
+
+/* An event that passes the whole segment with weight 1 and pdf ratios 1. */
+static inline void murk_event_init(murk_medium_event *ev, const murk_ray *ray)
+{
+    ev->scattered = 0;
+    ev->t = ray->tmax;
+    ev->weight = murk_rgb1(1.0f);
+    ev->pdf = murk_rgb1(1.0f);
+}
 
 /* Extinction per unit density. */
 static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb_add(d->sigma_a, d->sigma_s); }
@@ -21,6 +68,47 @@ static inline float murk_real_prob(float a, float b)
 {
     float s = fabsf(a) + fabsf(b);
     return s > 0.0f ? fabsf(a) / s : 0.0f;
+}
+
+/* Tentative collisions along a ray: a Poisson process whose rate in each majorant cell is
+ * mu = (the cell's maximum density) x sigma, walked cell by cell (delta tracking's proposal). */
+typedef struct murk_collisions {
+    const murk_tracker *tr;
+    const murk_ray *ray;
+    murk_majorant_walk walk;
+    float sigma, t, tb, mu, dmin;
+} murk_collisions;
+
+static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *tr, const murk_ray *ray, float sigma)
+{
+    c->tr = tr;
+    c->ray = ray;
+    c->sigma = sigma;
+    c->t = c->tb = ray->tmin;
+    c->mu = 0.0f;
+    c->dmin = 0.0f;
+    tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
+}
+
+/* The next tentative collision: its distance *t and the density *dens there; c->mu is the majorant rate
+ * it was drawn with. Returns 0 when the ray's segment is used up. */
+static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
+{
+    for (;;) {
+        if (c->mu > 0.0f) {
+            c->t += murk_sample_exp(rng, c->mu);
+            if (c->t < c->tb) {
+                *t = c->t;
+                *dens = c->tr->host->density(c->tr->d->density, murk_madd(c->ray->o, c->ray->d, c->t));
+                return 1;
+            }
+        }
+        float ta, dmax;
+        if (!c->tr->host->walk_next(&c->walk, &ta, &c->tb, &dmax, &c->dmin))
+            return 0;
+        c->t = ta;
+        c->mu = dmax * c->sigma;
+    }
 }
 
 /* Ratio tracking (Novak et al. 2014) over (ray->tmin, ray->tmax) with majorant segments from the
