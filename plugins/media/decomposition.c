@@ -9,15 +9,18 @@
  *            control can exceed the density: the residual goes negative and murk switches to weighted
  *            residual collisions (unbiased, noisier) and says so once. 0 is plain delta tracking.
  *
- * Per cell: control rate sigma_c = c sigma_t (c = control x minorant), residual majorant
- * mu_r = (max density - c) max_c sigma_t. The first of a control event (always real) and a residual
- * tentative event (real with probability (d(x) - c) sigma_t / mu_r) decides the flight; both processes
- * are memoryless, so a pending control distance survives a null residual event. A real collision
- * scatters with weight albedo. The total real-collision rate is c sigma_t + (d(x) - c) sigma_t =
- * d(x) sigma_t: the expected image does not depend on `control` — only noise and time do.
- * With chromatic extinction the channel-average rates are sampled and every channel reweighted (the
- * control part by exp(-(sigma_c,k - mean sigma_c) s) and sigma_c,k / mean sigma_c), which stays unbiased.
- * Transmittance: the control part in closed form times ratio tracking of the residual. */
+ * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
+ * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
+ * mu_r = max density x max_c sigma_t - c sigma_min. The first of a control event (real in every channel)
+ * and a residual tentative event decides the flight; both processes are memoryless, so a pending control
+ * distance survives a null residual event. A residual event is real with probability
+ * a = (d(x) sigma_t - c sigma_min) / mu_r for grey extinction; for chromatic extinction the choice is
+ * history-aware over the channels' a_c (as in delta.c) and each channel is reweighted by a_c / q (real)
+ * or (1 - a_c) / (1 - q) (null). A real collision scatters with weight albedo. The real-collision rate of
+ * channel c is c sigma_min + (d(x) sigma_t,c - c sigma_min) = d(x) sigma_t,c: the expected image does not
+ * depend on `control` — only noise and time do. Transmittance: the control part in closed form times
+ * ratio tracking of the residual. Where the majorant fails to bound (majorant_factor < 1) or the control
+ * exceeds the density, residual collisions are weighted (unbiased) and murk says so once. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -30,7 +33,7 @@ static const murk_param params[P_COUNT] = {
 
 typedef struct decomposition {
     murk_tracker base;
-    float savg, control;
+    float smin, control;
     int grey;
 } decomposition;
 
@@ -40,7 +43,7 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     decomposition *m = murk_tracker_new(host, data, sizeof *m, err, errlen);
     if (!m)
         return -1;
-    m->savg = murk_rgb_avg(m->base.sigma_t);
+    m->smin = murk_minf(m->base.sigma_t.c[0], murk_minf(m->base.sigma_t.c[1], m->base.sigma_t.c[2]));
     m->grey = m->base.sigma_t.c[0] == m->base.sigma_t.c[1] && m->base.sigma_t.c[1] == m->base.sigma_t.c[2];
     m->control = (float)p[P_CONTROL].f[0];
     if (m->control > 1.0f)
@@ -51,22 +54,13 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     return 0;
 }
 
-/* Weights channel k by the control process having been sampled at the average rate over length s. */
-static void control_tilt(const decomposition *m, float c, float s, murk_rgb *w)
-{
-    if (c <= 0.0f || s <= 0.0f)
-        return;
-    for (int k = 0; k < 3; k++)
-        w->c[k] *= expf(-c * (m->base.sigma_t.c[k] - m->savg) * s);
-}
-
 static int decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                                 murk_medium_event *ev)
 {
-    (void)ctx;
     const decomposition *m = self;
     const murk_host *h = m->base.host;
     const murk_medium_data *d = m->base.d;
+    const murk_rgb st = m->base.sigma_t;
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
         return 0;
@@ -74,46 +68,51 @@ static int decomposition_sample(const void *self, const murk_ray *ray, const mur
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin;
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
-        float c = m->control * dmin;
-        float rate_c = c * m->savg; /* control events, sampled at the channel-average rate */
-        float mu_r = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * m->base.smax;
+        float rate_c = m->control * dmin * m->smin; /* control collisions: real in every channel */
+        float mu_r = dmax * m->base.smax - rate_c;
+        mu_r = murk_maxf(fabsf(mu_r), 1e-3f * murk_maxf(dmax * m->base.smax, rate_c));
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
         float tc = rate_c > 0.0f ? ta + murk_sample_exp(rng, rate_c) : INFINITY;
-        float t = ta;
-        for (;;) {
+        for (float t = ta;;) {
             float tr = mu_r > 0.0f ? t + murk_sample_exp(rng, mu_r) : INFINITY;
-            if (!(tc < tb) && !(tr < tb)) {
-                if (isfinite(tb))
-                    control_tilt(m, c, tb - ta, &ev->weight);
+            if (!(tc < tb) && !(tr < tb))
                 break;
-            }
-            if (tc <= tr) { /* control collision: always real */
-                control_tilt(m, c, tc - ta, &ev->weight);
-                for (int k = 0; k < 3; k++) /* (sigma_c,k / mean sigma_c) * albedo_k */
-                    ev->weight.c[k] *= d->sigma_s.c[k] / m->savg;
+            if (tc <= tr) { /* control collision */
+                for (int k = 0; k < 3; k++)
+                    ev->weight.c[k] *= st.c[k] > 0.0f ? d->sigma_s.c[k] / st.c[k] : 0.0f;
                 ev->scattered = 1;
                 ev->t = tc;
                 return 1;
             }
             t = tr;
-            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t)) - c; /* residual density */
-            if (dens < 0.0f)
+            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
+            float a[3], amin = INFINITY, amax = -INFINITY, pr = 0.0f, pn = 0.0f;
+            for (int k = 0; k < 3; k++) { /* residual share of channel k */
+                a[k] = (dens * st.c[k] - rate_c) / mu_r;
+                amin = murk_minf(amin, a[k]);
+                amax = murk_maxf(amax, a[k]);
+                float hk = fabsf(ctx->beta.c[k] * ev->weight.c[k]);
+                pr += hk * fabsf(a[k]);
+                pn += hk * fabsf(1.0f - a[k]);
+            }
+            if (amin < 0.0f)
                 h->warn_once("medium '%s': decomposition control exceeds the local density (negative residual): "
                              "weighted residual collisions (unbiased, noisier)", d->name);
-            float a = dens * m->savg / mu_r;
-            float q = murk_real_prob(a, 1.0f - a);
+            if (amax > 1.0f)
+                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): decomposition "
+                             "tracking switches to weighted residual collisions (unbiased, noisier)", d->name);
+            float q = m->grey ? murk_real_prob(a[0], 1.0f - a[0]) : (pr + pn > 0.0f ? pr / (pr + pn) : 0.5f);
             if (murk_rng_float(rng) < q) {
-                control_tilt(m, c, t - ta, &ev->weight);
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= dens * d->sigma_s.c[k] / (mu_r * q);
+                    ev->weight.c[k] *= st.c[k] > 0.0f ? a[k] / q * (d->sigma_s.c[k] / st.c[k]) : 0.0f;
                 ev->scattered = 1;
                 ev->t = t;
                 return 1;
             }
-            if (dens < 0.0f || a > 1.0f || !m->grey)
+            if (!m->grey || amin < 0.0f || amax > 1.0f)
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= (1.0f - dens * m->base.sigma_t.c[k] / mu_r) / (1.0f - q);
+                    ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q);
         }
     }
     return 0;
