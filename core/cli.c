@@ -210,7 +210,7 @@ static void describe(const murk_plugin *p)
     printf("%s %s — %s\n  file: %s (ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path,
            p->abi.major, p->abi.minor);
     if (d->kind == MURK_KIND_MEDIUM)
-        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor\n");
+        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor, majorant_resolution\n");
     if (!d->nparams) {
         printf("  no parameters\n");
         return;

@@ -560,6 +560,55 @@ static void test_stability(void **state)
 }
 
 #ifndef MEDIA_RENDER_NO_MAIN
+/* The camera inside a medium (camera: { medium: fog }): a scattering-only fog filling a sphere that
+ * surrounds the camera, under a unit sky, still renders 1 per channel — for every tracker and both
+ * integrators. Without the camera medium the first flight would miss the fog entirely (the view would
+ * be 1 everywhere for the wrong reason), so the test also checks that the fog is really there: with an
+ * absorbing fog and the camera inside, the sky is dimmed to exp(-sigma_a R). */
+static void test_camera_inside(void **state)
+{
+    (void)state;
+    nfail = 0;
+    for (size_t t = 0; t < sizeof TRACKERS / sizeof TRACKERS[0]; t++)
+        for (size_t k = 0; k < 2; k++) {
+            const char *scene = scene_file("camera_inside.yaml",
+                "murk: 1\n"
+                "render: { resolution: [16, 16], spp: 1024, seed: 4 }\n"
+                "camera: { from: [0, 0, 0], at: [0, 0, -1], up: [0, 1, 0], fov: 60, medium: fog }\n"
+                "integrator: { type: %s, max_depth: 100000 }\n"
+                "background: 1\n"
+                "media: { fog: { type: %s, density: { constant: 1 }, sigma_a: 0, sigma_s: [0.5, 1, 2] } }\n"
+                "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, interior: fog } ]\n",
+                INTEGRATORS[k], TRACKERS[t]);
+            murk_image img;
+            render_img(scene, out_path("camera_inside.exr"), &img, NULL, NULL, NULL, NULL);
+            const double one[3] = {1, 1, 1};
+            chstats st;
+            channel_stats(&img, one, &st);
+            char label[128];
+            snprintf(label, sizeof label, "camera in fog, %s/%s", TRACKERS[t], INTEGRATORS[k]);
+            check_channels(label, &st, one);
+            murk_image_free(&img);
+        }
+    /* absorbing fog, sigma_a = [0.5, 1, 2], radius 1: every camera ray sees exp(-sigma_a) */
+    const char *scene = scene_file("camera_inside_abs.yaml",
+        "murk: 1\n"
+        "render: { resolution: [16, 16], spp: 1024, seed: 4 }\n"
+        "camera: { from: [0, 0, 0], at: [0, 0, -1], up: [0, 1, 0], fov: 60, medium: fog }\n"
+        "integrator: { type: volpath_nee }\n"
+        "background: 1\n"
+        "media: { fog: { type: spectral_mis, density: { constant: 1 }, sigma_a: [0.5, 1, 2], sigma_s: 0 } }\n"
+        "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, interior: fog } ]\n");
+    murk_image img;
+    render_img(scene, out_path("camera_inside_abs.exr"), &img, NULL, NULL, NULL, NULL);
+    const double ex[3] = {exp(-0.5), exp(-1.0), exp(-2.0)};
+    chstats st;
+    channel_stats(&img, ex, &st);
+    check_channels("camera in absorbing fog (spectral_mis)", &st, ex);
+    murk_image_free(&img);
+    assert_int_equal(nfail, 0);
+}
+
 int main(int argc, char **argv)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
@@ -571,6 +620,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_slab),
         cmocka_unit_test(test_invariance),
         cmocka_unit_test(test_stability),
+        cmocka_unit_test(test_camera_inside),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
