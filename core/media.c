@@ -18,6 +18,7 @@
 #include "density.h"
 #include "host.h"
 #include "util.h"
+#include "yread.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -127,61 +128,12 @@ murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *p
 
 /* ---- scene loading ------------------------------------------------------------------------- */
 
-static int number(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err, size_t errlen)
-{
-    char *end;
-    if (!n || n->kind != MURK_Y_SCALAR)
-        return murk_yerr(err, errlen, n, "%s must be a number", what);
-    *out = strtod(n->str, &end);
-    if (!*n->str || *end || !isfinite(*out))
-        return murk_yerr(err, errlen, n, "%s must be a number, got '%s'", what, n->str);
-    if (*out < lo || *out > hi)
-        return murk_yerr(err, errlen, n, "%s must be in [%g, %g], got %g", what, lo, hi, *out);
-    return 0;
-}
-
 static int rgb(const murk_ynode *n, const char *what, double lo, double hi, murk_rgb *out, char *err, size_t errlen)
 {
     double v[3];
-    if (n->kind == MURK_Y_SCALAR) {
-        if (number(n, what, lo, hi, &v[0], err, errlen))
-            return -1;
-        v[1] = v[2] = v[0];
-    } else if (n->kind == MURK_Y_SEQ && n->n == 3) {
-        for (int i = 0; i < 3; i++)
-            if (number(n->items[i], what, lo, hi, &v[i], err, errlen))
-                return -1;
-    } else {
-        return murk_yerr(err, errlen, n, "%s must be [r, g, b] or one number", what);
-    }
+    if (murk_yread_rgb(n, what, lo, hi, v, err, errlen))
+        return -1;
     *out = murk_rgb3((float)v[0], (float)v[1], (float)v[2]);
-    return 0;
-}
-
-static int vec3(const murk_ynode *n, const char *what, murk_vec3 *out, char *err, size_t errlen)
-{
-    if (!n || n->kind != MURK_Y_SEQ || n->n != 3)
-        return murk_yerr(err, errlen, n, "%s must be [x, y, z]", what);
-    double v[3];
-    for (int i = 0; i < 3; i++)
-        if (number(n->items[i], what, -1e30, 1e30, &v[i], err, errlen))
-            return -1;
-    *out = murk_v3((float)v[0], (float)v[1], (float)v[2]);
-    return 0;
-}
-
-static int only_keys(const murk_ynode *m, const char *what, const char *const *keys, size_t nk, char *err, size_t errlen)
-{
-    for (size_t i = 0; i < m->n; i++) {
-        size_t j = 0;
-        while (j < nk && strcmp(m->keys[i], keys[j]) != 0)
-            j++;
-        if (j < nk)
-            continue;
-        const char *s = murk_did_you_mean(m->keys[i], keys, nk);
-        return murk_yerr_key(err, errlen, m, i, "unknown key '%s' in %s%s%s%s", m->keys[i], what, s ? " (did you mean '" : "",
-                             s ? s : "", s ? "'?)" : "");
-    }
     return 0;
 }
 
@@ -192,18 +144,18 @@ static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
         murk_yerr(err, errlen, c, "cloud must be a map { min, max, seed, frequency, octaves, coverage, resolution }");
         return NULL;
     }
-    if (only_keys(c, "cloud", keys, 7, err, errlen))
+    if (murk_ycheck_keys(c, "cloud", keys, 7, err, errlen))
         return NULL;
     murk_vec3 lo = murk_v3(-0.5f, -0.5f, -0.5f), hi = murk_v3(0.5f, 0.5f, 0.5f);
     double seed = 1, freq = 3, oct = 5, cov = 0.5, res = 64;
     const murk_ynode *k;
-    if (((k = murk_ymap_get(c, "min")) && vec3(k, "cloud.min", &lo, err, errlen)) ||
-        ((k = murk_ymap_get(c, "max")) && vec3(k, "cloud.max", &hi, err, errlen)) ||
-        ((k = murk_ymap_get(c, "seed")) && number(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
-        ((k = murk_ymap_get(c, "frequency")) && number(k, "cloud.frequency", 0.01, 1000, &freq, err, errlen)) ||
-        ((k = murk_ymap_get(c, "octaves")) && number(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
-        ((k = murk_ymap_get(c, "coverage")) && number(k, "cloud.coverage", 0, 1, &cov, err, errlen)) ||
-        ((k = murk_ymap_get(c, "resolution")) && number(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
+    if (((k = murk_ymap_get(c, "min")) && murk_yread_vec3(k, "cloud.min", &lo, err, errlen)) ||
+        ((k = murk_ymap_get(c, "max")) && murk_yread_vec3(k, "cloud.max", &hi, err, errlen)) ||
+        ((k = murk_ymap_get(c, "seed")) && murk_yread_range(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
+        ((k = murk_ymap_get(c, "frequency")) && murk_yread_range(k, "cloud.frequency", 0.01, 1000, &freq, err, errlen)) ||
+        ((k = murk_ymap_get(c, "octaves")) && murk_yread_range(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
+        ((k = murk_ymap_get(c, "coverage")) && murk_yread_range(k, "cloud.coverage", 0, 1, &cov, err, errlen)) ||
+        ((k = murk_ymap_get(c, "resolution")) && murk_yread_range(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
         return NULL;
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
         murk_yerr(err, errlen, c, "cloud: max must exceed min on every axis");
@@ -222,12 +174,12 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
         murk_yerr(err, errlen, d, "density must be one of { constant: V }, { grid: FILE.vol|FILE.nvdb }, { cloud: {...} }");
         return NULL;
     }
-    if (only_keys(d, "density", keys, 3, err, errlen))
+    if (murk_ycheck_keys(d, "density", keys, 3, err, errlen))
         return NULL;
     const murk_ynode *k;
     if ((k = murk_ymap_get(d, "constant"))) {
         double v;
-        if (number(k, "density.constant", 0, 1e30, &v, err, errlen))
+        if (murk_yread_range(k, "density.constant", 0, 1e30, &v, err, errlen))
             return NULL;
         return murk_field_constant((float)v);
     }
@@ -284,10 +236,10 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     const murk_ynode *k;
     if (((k = murk_ymap_get(m, "sigma_a")) && rgb(k, "sigma_a", 0, 1e8, &md->sigma_a, err, errlen)) ||
         ((k = murk_ymap_get(m, "sigma_s")) && rgb(k, "sigma_s", 0, 1e8, &md->sigma_s, err, errlen)) ||
-        ((k = murk_ymap_get(m, "scale")) && number(k, "scale", 0, 1e8, &scale, err, errlen)) ||
-        ((k = murk_ymap_get(m, "g")) && number(k, "g (Henyey-Greenstein asymmetry)", -0.99, 0.99, &g, err, errlen)) ||
-        ((k = murk_ymap_get(m, "majorant_factor")) && number(k, "majorant_factor", 1e-3, 1e3, &mf, err, errlen)) ||
-        ((k = murk_ymap_get(m, "majorant_resolution")) && number(k, "majorant_resolution", 1, 256, &mres, err, errlen)))
+        ((k = murk_ymap_get(m, "scale")) && murk_yread_range(k, "scale", 0, 1e8, &scale, err, errlen)) ||
+        ((k = murk_ymap_get(m, "g")) && murk_yread_range(k, "g (Henyey-Greenstein asymmetry)", -0.99, 0.99, &g, err, errlen)) ||
+        ((k = murk_ymap_get(m, "majorant_factor")) && murk_yread_range(k, "majorant_factor", 1e-3, 1e3, &mf, err, errlen)) ||
+        ((k = murk_ymap_get(m, "majorant_resolution")) && murk_yread_range(k, "majorant_resolution", 1, 256, &mres, err, errlen)))
         return -1;
     md->sigma_a = murk_rgb_scale(md->sigma_a, (float)scale);
     md->sigma_s = murk_rgb_scale(md->sigma_s, (float)scale);

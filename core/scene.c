@@ -9,6 +9,7 @@
 #include "obj.h"
 #include "texture.h"
 #include "util.h"
+#include "yread.h"
 
 #include <errno.h>
 #include <math.h>
@@ -18,146 +19,7 @@
 
 #define ERR(node, ...) murk_yerr(err, errlen, (node), __VA_ARGS__)
 
-/* ---- Typed value readers ------------------------------------------------------------------- */
-
-static int read_number(const murk_ynode *n, const char *what, double *out, char *err, size_t errlen)
-{
-    if (n->kind != MURK_Y_SCALAR)
-        return ERR(n, "%s must be a number, got a %s", what, n->kind == MURK_Y_MAP ? "map" : "list");
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(n->str, &end);
-    if (!*n->str || *end || isnan(v) || (n->str[0] == '0' && (n->str[1] == 'x' || n->str[1] == 'X')))
-        return ERR(n, "%s must be a number, got '%s'", what, n->str);
-    if (isinf(v) || (errno == ERANGE && fabs(v) > 1.0))
-        return ERR(n, "%s is too large, got '%s'", what, n->str);
-    if (errno == ERANGE) /* underflow: as good as 0 */
-        v = 0.0;
-    *out = v;
-    return 0;
-}
-
-static int read_range(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err,
-                      size_t errlen)
-{
-    if (read_number(n, what, out, err, errlen))
-        return -1;
-    if (*out < lo || *out > hi)
-        return ERR(n, "%s must be in [%g, %g], got %g", what, lo, hi, *out);
-    return 0;
-}
-
-static int read_int(const murk_ynode *n, const char *what, double lo, double hi, long long *out, char *err,
-                    size_t errlen)
-{
-    double v = 0;
-    if (read_number(n, what, &v, err, errlen))
-        return -1;
-    if (v != floor(v))
-        return ERR(n, "%s must be a whole number, got '%s'", what, n->str);
-    if (v < lo || v > hi)
-        return ERR(n, "%s must be in [%.0f, %.0f], got %s", what, lo, hi, n->str);
-    *out = (long long)v;
-    return 0;
-}
-
-static int read_bool(const murk_ynode *n, const char *what, int *out, char *err, size_t errlen)
-{
-    if (n->kind == MURK_Y_SCALAR) {
-        if (!strcmp(n->str, "true") || !strcmp(n->str, "yes") || !strcmp(n->str, "on")) {
-            *out = 1;
-            return 0;
-        }
-        if (!strcmp(n->str, "false") || !strcmp(n->str, "no") || !strcmp(n->str, "off")) {
-            *out = 0;
-            return 0;
-        }
-    }
-    return ERR(n, "%s must be true or false", what);
-}
-
-/* A fixed-length list of numbers in [lo, hi]. */
-static int read_list(const murk_ynode *n, const char *what, int len, double lo, double hi, double *out, char *err,
-                     size_t errlen)
-{
-    if (n->kind != MURK_Y_SEQ || n->n != (size_t)len)
-        return ERR(n, "%s must be a list of %d numbers", what, len);
-    for (int i = 0; i < len; i++)
-        if (read_range(n->items[i], what, lo, hi, &out[i], err, errlen))
-            return -1;
-    return 0;
-}
-
-static int read_vec3(const murk_ynode *n, const char *what, murk_vec3 *v, char *err, size_t errlen)
-{
-    double d[3];
-    if (read_list(n, what, 3, -1e30, 1e30, d, err, errlen))
-        return -1;
-    *v = murk_v3((float)d[0], (float)d[1], (float)d[2]);
-    return 0;
-}
-
-/* RGB: [r, g, b] or one number for grey. */
-static int read_rgb(const murk_ynode *n, const char *what, double lo, double hi, double out[3], char *err,
-                    size_t errlen)
-{
-    if (n->kind == MURK_Y_SCALAR) {
-        if (read_range(n, what, lo, hi, &out[0], err, errlen))
-            return -1;
-        out[1] = out[2] = out[0];
-        return 0;
-    }
-    if (n->kind != MURK_Y_SEQ || n->n != 3)
-        return ERR(n, "%s must be [r, g, b] or one number", what);
-    return read_list(n, what, 3, lo, hi, out, err, errlen);
-}
-
 static murk_rgb to_rgb(const double d[3]) { return murk_rgb3((float)d[0], (float)d[1], (float)d[2]); }
-
-static int read_string(const murk_ynode *n, const char *what, const char **out, char *err, size_t errlen)
-{
-    if (n->kind != MURK_Y_SCALAR || !*n->str)
-        return ERR(n, "%s must be a name or a path", what);
-    *out = n->str;
-    return 0;
-}
-
-static int expect_map(const murk_ynode *n, const char *what, char *err, size_t errlen)
-{
-    if (!n || n->kind != MURK_Y_MAP)
-        return ERR(n, "%s must be a map of keys", what);
-    return 0;
-}
-
-/* Refuses any key of map that is not in allowed[], suggesting the closest. */
-static int check_keys(const murk_ynode *map, const char *what, const char *const *allowed, size_t nallowed,
-                      char *err, size_t errlen)
-{
-    for (size_t i = 0; i < map->n; i++) {
-        int ok = 0;
-        for (size_t j = 0; j < nallowed && !ok; j++)
-            ok = strcmp(map->keys[i], allowed[j]) == 0;
-        if (ok)
-            continue;
-        const char *s = murk_did_you_mean(map->keys[i], allowed, nallowed);
-        if (s)
-            return murk_yerr_key(err, errlen, map, i, "unknown key '%s' in %s (did you mean '%s'?)", map->keys[i], what, s);
-        int k = murk_yerr_key(err, errlen, map, i, "unknown key '%s' in %s; expected one of:", map->keys[i], what);
-        size_t len = strlen(err);
-        for (size_t j = 0; j < nallowed && len < errlen; j++)
-            len += (size_t)snprintf(err + len, errlen - len, "%s %s", j ? "," : "", allowed[j]);
-        return k;
-    }
-    return 0;
-}
-
-static const murk_ynode *require(const murk_ynode *map, const char *key, const char *what, char *err, size_t errlen)
-{
-    const murk_ynode *n = murk_ymap_get(map, key);
-    if (!n)
-        murk_yerr(err, errlen, map, "%s is missing the required key '%s'", what, key);
-    return n;
-}
 
 #define NKEYS(a) (sizeof(a) / sizeof((a)[0]))
 
@@ -253,25 +115,25 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
             } else if (n->kind == MURK_Y_MAP) {
                 return ERR(n, "%s does not take a texture", what);
             } else if (p->type == MURK_PARAM_FLOAT) {
-                if (read_range(n, what, p->min, p->max, &v->f[0], err, errlen))
+                if (murk_yread_range(n, what, p->min, p->max, &v->f[0], err, errlen))
                     return -1;
                 v->f[1] = v->f[2] = v->f[0];
-            } else if (read_rgb(n, what, p->min, p->max, v->f, err, errlen)) {
+            } else if (murk_yread_rgb(n, what, p->min, p->max, v->f, err, errlen)) {
                 return -1;
             }
             break;
         case MURK_PARAM_INT:
-            if (read_int(n, what, p->min, p->max, &iv, err, errlen))
+            if (murk_yread_int(n, what, p->min, p->max, &iv, err, errlen))
                 return -1;
             v->f[0] = (double)iv;
             break;
         case MURK_PARAM_BOOL:
-            if (read_bool(n, what, &bv, err, errlen))
+            if (murk_yread_bool(n, what, &bv, err, errlen))
                 return -1;
             v->f[0] = bv;
             break;
         case MURK_PARAM_STRING:
-            if (read_string(n, what, &v->s, err, errlen))
+            if (murk_yread_string(n, what, &v->s, err, errlen))
                 return -1;
             break;
         case MURK_PARAM_ENUM:
@@ -306,13 +168,13 @@ static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t err
     s->exposure = 0.0f;
     if (!n)
         return 0;
-    if (expect_map(n, "render", err, errlen) || check_keys(n, "render", keys, NKEYS(keys), err, errlen))
+    if (murk_yexpect_map(n, "render", err, errlen) || murk_ycheck_keys(n, "render", keys, NKEYS(keys), err, errlen))
         return -1;
     const murk_ynode *c;
     long long v;
     if ((c = murk_ymap_get(n, "resolution"))) {
         double r[2];
-        if (read_list(c, "render.resolution", 2, 1, 16384, r, err, errlen))
+        if (murk_yread_list(c, "render.resolution", 2, 1, 16384, r, err, errlen))
             return -1;
         if (r[0] != floor(r[0]) || r[1] != floor(r[1]))
             return ERR(c, "render.resolution must be whole numbers");
@@ -320,18 +182,18 @@ static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t err
         s->height = (int)r[1];
     }
     if ((c = murk_ymap_get(n, "spp"))) {
-        if (read_int(c, "render.spp", 1, 1 << 24, &v, err, errlen))
+        if (murk_yread_int(c, "render.spp", 1, 1 << 24, &v, err, errlen))
             return -1;
         s->spp = (int)v;
     }
     if ((c = murk_ymap_get(n, "seed"))) {
-        if (read_int(c, "render.seed", 0, 9007199254740992.0, &v, err, errlen))
+        if (murk_yread_int(c, "render.seed", 0, 9007199254740992.0, &v, err, errlen))
             return -1;
         s->seed = (uint64_t)v;
     }
     if ((c = murk_ymap_get(n, "exposure"))) {
         double e;
-        if (read_range(c, "render.exposure", -30, 30, &e, err, errlen))
+        if (murk_yread_range(c, "render.exposure", -30, 30, &e, err, errlen))
             return -1;
         s->exposure = (float)e;
     }
@@ -349,7 +211,7 @@ static const murk_named_medium *find_medium(const murk_scene *s, const char *nam
 static int lookup_medium(const murk_scene *s, const murk_ynode *n, const murk_medium **out, char *err, size_t errlen)
 {
     const char *name = NULL;
-    if (read_string(n, "a medium reference", &name, err, errlen))
+    if (murk_yread_string(n, "a medium reference", &name, err, errlen))
         return -1;
     const murk_named_medium *m = find_medium(s, name);
     if (m) {
@@ -374,18 +236,18 @@ static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t err
     s->cam_up = murk_v3(0, 1, 0);
     s->fov = 40.0f;
     if (n) {
-        if (expect_map(n, "camera", err, errlen) || check_keys(n, "camera", keys, NKEYS(keys), err, errlen))
+        if (murk_yexpect_map(n, "camera", err, errlen) || murk_ycheck_keys(n, "camera", keys, NKEYS(keys), err, errlen))
             return -1;
         const murk_ynode *c;
-        if ((c = murk_ymap_get(n, "from")) && read_vec3(c, "camera.from", &s->cam_from, err, errlen))
+        if ((c = murk_ymap_get(n, "from")) && murk_yread_vec3(c, "camera.from", &s->cam_from, err, errlen))
             return -1;
-        if ((c = murk_ymap_get(n, "at")) && read_vec3(c, "camera.at", &s->cam_at, err, errlen))
+        if ((c = murk_ymap_get(n, "at")) && murk_yread_vec3(c, "camera.at", &s->cam_at, err, errlen))
             return -1;
-        if ((c = murk_ymap_get(n, "up")) && read_vec3(c, "camera.up", &s->cam_up, err, errlen))
+        if ((c = murk_ymap_get(n, "up")) && murk_yread_vec3(c, "camera.up", &s->cam_up, err, errlen))
             return -1;
         double fov;
         if ((c = murk_ymap_get(n, "fov"))) {
-            if (read_range(c, "camera.fov", 0.01, 179.0, &fov, err, errlen))
+            if (murk_yread_range(c, "camera.fov", 0.01, 179.0, &fov, err, errlen))
                 return -1;
             s->fov = (float)fov;
         }
@@ -409,18 +271,18 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
 {
     if (!n)
         return 0;
-    if (expect_map(n, "materials", err, errlen))
+    if (murk_yexpect_map(n, "materials", err, errlen))
         return -1;
     s->materials = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->materials);
     for (size_t i = 0; i < n->n; i++) {
         const murk_ynode *m = n->items[i];
         char who[256];
         snprintf(who, sizeof who, "material '%s'", n->keys[i]);
-        if (expect_map(m, who, err, errlen))
+        if (murk_yexpect_map(m, who, err, errlen))
             return -1;
-        const murk_ynode *t = require(m, "type", who, err, errlen);
+        const murk_ynode *t = murk_yrequire(m, "type", who, err, errlen);
         const char *type = NULL;
-        if (!t || read_string(t, "type", &type, err, errlen))
+        if (!t || murk_yread_string(t, "type", &type, err, errlen))
             return -1;
         char lerr[1024];
         const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_MATERIAL, type, lerr, sizeof lerr);
@@ -453,10 +315,10 @@ static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t
     static const murk_ynode empty = {.kind = MURK_Y_MAP, .file = "(default)", .line = 1, .col = 1};
     const char *type = "path";
     if (n) {
-        if (expect_map(n, "integrator", err, errlen))
+        if (murk_yexpect_map(n, "integrator", err, errlen))
             return -1;
-        const murk_ynode *t = require(n, "type", "integrator", err, errlen);
-        if (!t || read_string(t, "integrator.type", &type, err, errlen))
+        const murk_ynode *t = murk_yrequire(n, "type", "integrator", err, errlen);
+        if (!t || murk_yread_string(t, "integrator.type", &type, err, errlen))
             return -1;
     } else {
         n = &empty;
@@ -492,7 +354,7 @@ static int lookup_material(const murk_scene *s, const murk_ynode *n, const murk_
                            size_t errlen)
 {
     const char *name = NULL;
-    if (read_string(n, "material", &name, err, errlen))
+    if (murk_yread_string(n, "material", &name, err, errlen))
         return -1;
     if ((*out = find_material(s, name)))
         return 0;
@@ -539,15 +401,15 @@ static void put_quad(murk_shape *sh, uint32_t q, murk_vec3 c, murk_vec3 u, murk_
 static int read_transform(const murk_ynode *n, float m[12], char *err, size_t errlen)
 {
     static const char *const keys[] = {"scale", "rotate", "translate"};
-    if (expect_map(n, "transform", err, errlen) || check_keys(n, "transform", keys, NKEYS(keys), err, errlen))
+    if (murk_yexpect_map(n, "transform", err, errlen) || murk_ycheck_keys(n, "transform", keys, NKEYS(keys), err, errlen))
         return -1;
     double sc[3] = {1, 1, 1}, rot[3] = {0, 0, 0}, tr[3] = {0, 0, 0};
     const murk_ynode *c;
-    if ((c = murk_ymap_get(n, "scale")) && read_rgb(c, "transform.scale", -1e30, 1e30, sc, err, errlen))
+    if ((c = murk_ymap_get(n, "scale")) && murk_yread_rgb(c, "transform.scale", -1e30, 1e30, sc, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "rotate")) && read_list(c, "transform.rotate", 3, -1e6, 1e6, rot, err, errlen))
+    if ((c = murk_ymap_get(n, "rotate")) && murk_yread_list(c, "transform.rotate", 3, -1e6, 1e6, rot, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "translate")) && read_list(c, "transform.translate", 3, -1e30, 1e30, tr, err, errlen))
+    if ((c = murk_ymap_get(n, "translate")) && murk_yread_list(c, "transform.translate", 3, -1e30, 1e30, tr, err, errlen))
         return -1;
     if (sc[0] == 0 || sc[1] == 0 || sc[2] == 0)
         return ERR(murk_ymap_get(n, "scale"), "transform.scale must not be 0");
@@ -567,9 +429,9 @@ static int read_transform(const murk_ynode *n, float m[12], char *err, size_t er
 
 static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *err, size_t errlen)
 {
-    const murk_ynode *f = require(n, "file", "mesh shape", err, errlen);
+    const murk_ynode *f = murk_yrequire(n, "file", "mesh shape", err, errlen);
     const char *file = NULL;
-    if (!f || read_string(f, "mesh.file", &file, err, errlen))
+    if (!f || murk_yread_string(f, "mesh.file", &file, err, errlen))
         return -1;
     float m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     const murk_ynode *t = murk_ymap_get(n, "transform");
@@ -622,23 +484,23 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
     static const char *const mesh_keys[] = {"type", "material", "emission", "interior", "exterior", "file", "transform"};
     static const char *const types[] = {"quad", "sphere", "box", "mesh"};
     (void)common;
-    if (expect_map(n, "a shape", err, errlen))
+    if (murk_yexpect_map(n, "a shape", err, errlen))
         return -1;
-    const murk_ynode *t = require(n, "type", "shape", err, errlen);
+    const murk_ynode *t = murk_yrequire(n, "type", "shape", err, errlen);
     const char *type = NULL;
-    if (!t || read_string(t, "shape type", &type, err, errlen))
+    if (!t || murk_yread_string(t, "shape type", &type, err, errlen))
         return -1;
     const murk_ynode *c;
     if (!strcmp(type, "quad")) {
         sh->type = MURK_SHAPE_QUAD;
-        if (check_keys(n, "quad", quad_keys, NKEYS(quad_keys), err, errlen))
+        if (murk_ycheck_keys(n, "quad", quad_keys, NKEYS(quad_keys), err, errlen))
             return -1;
         murk_vec3 ce, u, v;
-        if (!(c = require(n, "center", "quad", err, errlen)) || read_vec3(c, "quad.center", &ce, err, errlen))
+        if (!(c = murk_yrequire(n, "center", "quad", err, errlen)) || murk_yread_vec3(c, "quad.center", &ce, err, errlen))
             return -1;
-        if (!(c = require(n, "u", "quad", err, errlen)) || read_vec3(c, "quad.u", &u, err, errlen))
+        if (!(c = murk_yrequire(n, "u", "quad", err, errlen)) || murk_yread_vec3(c, "quad.u", &u, err, errlen))
             return -1;
-        if (!(c = require(n, "v", "quad", err, errlen)) || read_vec3(c, "quad.v", &v, err, errlen))
+        if (!(c = murk_yrequire(n, "v", "quad", err, errlen)) || murk_yread_vec3(c, "quad.v", &v, err, errlen))
             return -1;
         if (murk_length(murk_cross(u, v)) <= 0.0f)
             return ERR(n, "quad: u and v must span a non-degenerate parallelogram");
@@ -646,22 +508,22 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
         put_quad(sh, 0, ce, u, v);
     } else if (!strcmp(type, "sphere")) {
         sh->type = MURK_SHAPE_SPHERE;
-        if (check_keys(n, "sphere", sphere_keys, NKEYS(sphere_keys), err, errlen))
+        if (murk_ycheck_keys(n, "sphere", sphere_keys, NKEYS(sphere_keys), err, errlen))
             return -1;
         double r;
-        if (!(c = require(n, "center", "sphere", err, errlen)) || read_vec3(c, "sphere.center", &sh->center, err, errlen))
+        if (!(c = murk_yrequire(n, "center", "sphere", err, errlen)) || murk_yread_vec3(c, "sphere.center", &sh->center, err, errlen))
             return -1;
-        if (!(c = require(n, "radius", "sphere", err, errlen)) || read_range(c, "sphere.radius", 1e-6, 1e30, &r, err, errlen))
+        if (!(c = murk_yrequire(n, "radius", "sphere", err, errlen)) || murk_yread_range(c, "sphere.radius", 1e-6, 1e30, &r, err, errlen))
             return -1;
         sh->radius = (float)r;
     } else if (!strcmp(type, "box")) {
         sh->type = MURK_SHAPE_BOX;
-        if (check_keys(n, "box", box_keys, NKEYS(box_keys), err, errlen))
+        if (murk_ycheck_keys(n, "box", box_keys, NKEYS(box_keys), err, errlen))
             return -1;
         murk_vec3 lo, hi;
-        if (!(c = require(n, "min", "box", err, errlen)) || read_vec3(c, "box.min", &lo, err, errlen))
+        if (!(c = murk_yrequire(n, "min", "box", err, errlen)) || murk_yread_vec3(c, "box.min", &lo, err, errlen))
             return -1;
-        if (!(c = require(n, "max", "box", err, errlen)) || read_vec3(c, "box.max", &hi, err, errlen))
+        if (!(c = murk_yrequire(n, "max", "box", err, errlen)) || murk_yread_vec3(c, "box.max", &hi, err, errlen))
             return -1;
         if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z))
             return ERR(c, "box: max must exceed min on every axis");
@@ -677,7 +539,7 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
         put_quad(sh, 5, murk_sub(ce, Z), Y, X);
     } else if (!strcmp(type, "mesh")) {
         sh->type = MURK_SHAPE_MESH;
-        if (check_keys(n, "mesh", mesh_keys, NKEYS(mesh_keys), err, errlen) || load_mesh(s, sh, n, err, errlen))
+        if (murk_ycheck_keys(n, "mesh", mesh_keys, NKEYS(mesh_keys), err, errlen) || load_mesh(s, sh, n, err, errlen))
             return -1;
     } else {
         const char *sug = murk_did_you_mean(type, types, NKEYS(types));
@@ -693,7 +555,7 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
         return -1;
     if ((c = murk_ymap_get(n, "emission"))) {
         double e[3];
-        if (read_rgb(c, "emission", 0, 1e30, e, err, errlen))
+        if (murk_yread_rgb(c, "emission", 0, 1e30, e, err, errlen))
             return -1;
         sh->emission = to_rgb(e);
     }
@@ -740,11 +602,11 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
     if (!root)
         return murk_yerr(err, errlen, &(murk_ynode){.file = s->doc.file, .line = 1, .col = 1},
                          "empty scene (expected a map with at least 'murk: 1' and 'shapes')");
-    if (expect_map(root, "a scene", err, errlen) || check_keys(root, "the scene", keys, NKEYS(keys), err, errlen))
+    if (murk_yexpect_map(root, "a scene", err, errlen) || murk_ycheck_keys(root, "the scene", keys, NKEYS(keys), err, errlen))
         return -1;
-    const murk_ynode *v = require(root, "murk", "the scene", err, errlen);
+    const murk_ynode *v = murk_yrequire(root, "murk", "the scene", err, errlen);
     long long ver;
-    if (!v || read_int(v, "murk (the format version)", 0, 1e9, &ver, err, errlen))
+    if (!v || murk_yread_int(v, "murk (the format version)", 0, 1e9, &ver, err, errlen))
         return -1;
     if (ver != 1)
         return ERR(v, "scene format version %lld is not supported (this murk reads version 1)", ver);
@@ -752,7 +614,7 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
     if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
         return -1;
     double bg[3] = {0, 0, 0};
-    if ((c = murk_ymap_get(root, "background")) && read_rgb(c, "background", 0, 1e30, bg, err, errlen))
+    if ((c = murk_ymap_get(root, "background")) && murk_yread_rgb(c, "background", 0, 1e30, bg, err, errlen))
         return -1;
     s->background = to_rgb(bg);
     if ((c = murk_ymap_get(root, "media"))) {

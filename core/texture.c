@@ -2,6 +2,7 @@
 #include "texture.h"
 #include "image.h"
 #include "util.h"
+#include "yread.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -18,33 +19,11 @@ struct murk_texture {
     double avg[3];
 };
 
-static int num(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err, size_t errlen)
-{
-    char *end;
-    if (n->kind != MURK_Y_SCALAR)
-        return murk_yerr(err, errlen, n, "%s must be a number", what);
-    *out = strtod(n->str, &end);
-    if (!*n->str || *end || !isfinite(*out))
-        return murk_yerr(err, errlen, n, "%s must be a number, got '%s'", what, n->str);
-    if (*out < lo || *out > hi)
-        return murk_yerr(err, errlen, n, "%s must be in [%g, %g], got %g", what, lo, hi, *out);
-    return 0;
-}
-
 static int colour(const murk_ynode *n, const char *what, double lo, double hi, float out[3], char *err, size_t errlen)
 {
     double v[3];
-    if (n->kind == MURK_Y_SCALAR) {
-        if (num(n, what, lo, hi, &v[0], err, errlen))
-            return -1;
-        v[1] = v[2] = v[0];
-    } else if (n->kind == MURK_Y_SEQ && n->n == 3) {
-        for (int i = 0; i < 3; i++)
-            if (num(n->items[i], what, lo, hi, &v[i], err, errlen))
-                return -1;
-    } else {
-        return murk_yerr(err, errlen, n, "%s must be [r, g, b] or one number", what);
-    }
+    if (murk_yread_rgb(n, what, lo, hi, v, err, errlen))
+        return -1;
     for (int i = 0; i < 3; i++)
         out[i] = (float)v[i];
     return 0;
@@ -54,31 +33,16 @@ static int scale2(const murk_ynode *n, float *su, float *sv, char *err, size_t e
 {
     double a, b;
     if (n->kind == MURK_Y_SEQ && n->n == 2) {
-        if (num(n->items[0], "texture scale", 1e-6, 1e6, &a, err, errlen) ||
-            num(n->items[1], "texture scale", 1e-6, 1e6, &b, err, errlen))
+        if (murk_yread_range(n->items[0], "texture scale", 1e-6, 1e6, &a, err, errlen) ||
+            murk_yread_range(n->items[1], "texture scale", 1e-6, 1e6, &b, err, errlen))
             return -1;
     } else {
-        if (num(n, "texture scale", 1e-6, 1e6, &a, err, errlen))
+        if (murk_yread_range(n, "texture scale", 1e-6, 1e6, &a, err, errlen))
             return -1;
         b = a;
     }
     *su = (float)a;
     *sv = (float)b;
-    return 0;
-}
-
-static int check_keys(const murk_ynode *n, const char *const *keys, size_t nk, char *err, size_t errlen)
-{
-    for (size_t i = 0; i < n->n; i++) {
-        size_t j = 0;
-        while (j < nk && strcmp(n->keys[i], keys[j]) != 0)
-            j++;
-        if (j < nk)
-            continue;
-        const char *s = murk_did_you_mean(n->keys[i], keys, nk);
-        return murk_yerr_key(err, errlen, n, i, "unknown texture key '%s'%s%s%s", n->keys[i], s ? " (did you mean '" : "",
-                             s ? s : "", s ? "'?)" : "");
-    }
     return 0;
 }
 
@@ -100,7 +64,7 @@ murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, do
         t->su = t->sv = 8.0f;
         for (int i = 0; i < 3; i++)
             t->even[i] = (float)fmin(hi, fmax(lo, 0.8)), t->odd[i] = (float)fmin(hi, fmax(lo, 0.2));
-        if (check_keys(n, checker_keys, 4, err, errlen) ||
+        if (murk_ycheck_keys(n, "a checker texture", checker_keys, 4, err, errlen) ||
             ((c = murk_ymap_get(n, "even")) && colour(c, "checker 'even'", lo, hi, t->even, err, errlen)) ||
             ((c = murk_ymap_get(n, "odd")) && colour(c, "checker 'odd'", lo, hi, t->odd, err, errlen)) ||
             ((c = murk_ymap_get(n, "scale")) && scale2(c, &t->su, &t->sv, err, errlen)))
@@ -112,7 +76,7 @@ murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, do
     if (!strcmp(k->str, "image")) {
         t->kind = TEX_IMAGE;
         int srgb = 1;
-        if (check_keys(n, image_keys, 4, err, errlen))
+        if (murk_ycheck_keys(n, "an image texture", image_keys, 4, err, errlen))
             goto fail;
         const murk_ynode *f = murk_ymap_get(n, "file");
         if (!f || f->kind != MURK_Y_SCALAR) {
