@@ -24,7 +24,7 @@ def run(args):
 
 
 def render(scene, out, res, extra):
-    s = run(["render", os.path.join(ROOT, "scenes", scene + ".yaml"), "-o", out, "--quiet",
+    s = run(["render", os.path.join(ROOT, "scenes", scene + ".yaml"), "-o", out,
              "--set", "render.resolution=[%d,%d]" % (res, res)] + extra)
     return s
 
