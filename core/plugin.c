@@ -1,6 +1,7 @@
-/* plugin.c — the plugin loader. The ABI version is a data symbol read before any plugin function is
- * called; then the entry function's descriptor is checked field by field. Every refusal is one line
- * naming the file and the cause. */
+/* plugin.c — the plugin loader. The ABI version is a data symbol, read from the file's ELF dynamic
+ * symbol table before the object is even loaded, so no plugin code (not even an ELF constructor) runs
+ * before it is checked; then the entry function's descriptor is checked field by field. Every refusal
+ * is one line naming the file and the cause. */
 #include "plugin_loader.h"
 #include "util.h"
 
@@ -9,7 +10,10 @@
 #include "murk/medium.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <dlfcn.h>
+#include <elf.h>
+#include <link.h>
 #include <stdarg.h>
 #include <limits.h>
 #include <stdio.h>
@@ -140,31 +144,97 @@ static int check_params(const murk_plugin_desc *d, const char *path, char *err, 
     return 0;
 }
 
+/* Reads the plugin's murk_plugin_abi straight from the file's dynamic symbol table, so that a plugin
+ * built for another ABI is refused before any of its code — ELF constructors included, which dlopen()
+ * would run — gets a chance to execute. 0 found, 1 not an ELF shared object of this machine's class,
+ * 2 no such symbol, -1 unreadable (errno). */
+static int elf_read_abi(const char *path, murk_abi *abi)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return -1;
+    unsigned char *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (n == cap) {
+            if (cap >= ((size_t)256 << 20)) { /* no plugin is this large */
+                free(buf);
+                fclose(f);
+                return 1;
+            }
+            cap = cap ? 2 * cap : 65536;
+            buf = murk_xrealloc(buf, cap);
+        }
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (r == 0)
+            break;
+    }
+    fclose(f);
+    int rc = 1;
+    const ElfW(Ehdr) *eh = (const void *)buf;
+    if (n < sizeof *eh || memcmp(eh->e_ident, ELFMAG, SELFMAG) != 0 ||
+        eh->e_ident[EI_CLASS] != (sizeof(void *) == 8 ? ELFCLASS64 : ELFCLASS32) || eh->e_shentsize != sizeof(ElfW(Shdr)) ||
+        eh->e_shoff > n || (size_t)eh->e_shnum * sizeof(ElfW(Shdr)) > n - eh->e_shoff)
+        goto done;
+    const ElfW(Shdr) *sh = (const void *)(buf + eh->e_shoff);
+    rc = 2;
+    for (size_t i = 0; i < eh->e_shnum; i++) {
+        if (sh[i].sh_type != SHT_DYNSYM || sh[i].sh_link >= eh->e_shnum || sh[i].sh_entsize != sizeof(ElfW(Sym)))
+            continue;
+        const ElfW(Shdr) *strs = &sh[sh[i].sh_link];
+        if (sh[i].sh_offset > n || sh[i].sh_size > n - sh[i].sh_offset || strs->sh_offset > n ||
+            strs->sh_size > n - strs->sh_offset)
+            continue;
+        const ElfW(Sym) *sym = (const void *)(buf + sh[i].sh_offset);
+        const char *names = (const char *)(buf + strs->sh_offset);
+        for (size_t k = 0; k < sh[i].sh_size / sizeof *sym; k++) {
+            if (sym[k].st_name >= strs->sh_size || sym[k].st_shndx == SHN_UNDEF || sym[k].st_shndx >= eh->e_shnum ||
+                strnlen(names + sym[k].st_name, strs->sh_size - sym[k].st_name) == strs->sh_size - sym[k].st_name ||
+                strcmp(names + sym[k].st_name, MURK_PLUGIN_ABI_SYMBOL) != 0)
+                continue;
+            const ElfW(Shdr) *sec = &sh[sym[k].st_shndx];
+            if (sym[k].st_size < sizeof *abi || sec->sh_type == SHT_NOBITS || sym[k].st_value < sec->sh_addr)
+                goto done;
+            size_t off = sec->sh_offset + (size_t)(sym[k].st_value - sec->sh_addr);
+            if (off > n || n - off < sizeof *abi)
+                goto done;
+            memcpy(abi, buf + off, sizeof *abi);
+            rc = 0;
+            goto done;
+        }
+    }
+done:
+    free(buf);
+    return rc;
+}
+
 int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
+    murk_abi abicopy;
+    switch (elf_read_abi(path, &abicopy)) {
+    case -1: return fail(err, errlen, path, "cannot read: %s", strerror(errno));
+    case 1: return fail(err, errlen, path, "not an ELF shared object for this machine");
+    case 2: return fail(err, errlen, path, "no '%s' symbol: not a murk plugin", MURK_PLUGIN_ABI_SYMBOL);
+    default: break;
+    }
+    if (abicopy.major != MURK_ABI_MAJOR)
+        return fail(err, errlen, path,
+                    "built for plugin ABI %u.%u, this murk has ABI %d.%d (major versions differ: rebuild the plugin)",
+                    abicopy.major, abicopy.minor, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+    if (abicopy.minor > MURK_ABI_MINOR)
+        return fail(err, errlen, path, "needs plugin ABI %u.%u, this murk has ABI %d.%d (upgrade murk)", abicopy.major,
+                    abicopy.minor, MURK_ABI_MAJOR, MURK_ABI_MINOR);
     dlerror();
     void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!h)
         return fail(err, errlen, path, "cannot load: %s", dlerror());
     const murk_abi *abi = dlsym(h, MURK_PLUGIN_ABI_SYMBOL);
-    if (!abi) {
+    if (!abi || abi->major != abicopy.major || abi->minor != abicopy.minor) {
         dlclose(h);
-        return fail(err, errlen, path, "no '%s' symbol: not a murk plugin", MURK_PLUGIN_ABI_SYMBOL);
+        return fail(err, errlen, path, "'%s' as loaded differs from the file's symbol table", MURK_PLUGIN_ABI_SYMBOL);
     }
-    if (abi->major != MURK_ABI_MAJOR) {
-        fail(err, errlen, path, "built for plugin ABI %u.%u, this murk has ABI %d.%d (major versions differ: rebuild the plugin)",
-             abi->major, abi->minor, MURK_ABI_MAJOR, MURK_ABI_MINOR);
-        dlclose(h);
-        return -1;
-    }
-    if (abi->minor > MURK_ABI_MINOR) {
-        fail(err, errlen, path, "needs plugin ABI %u.%u, this murk has ABI %d.%d (upgrade murk)", abi->major, abi->minor,
-             MURK_ABI_MAJOR, MURK_ABI_MINOR);
-        dlclose(h);
-        return -1;
-    }
-    murk_abi abicopy = *abi;
     union {
         void *obj;
         const murk_plugin_desc *(*fn)(void);

@@ -185,11 +185,15 @@ static void test_open_not_a_library(void **state)
     const char *missing = fixture("no_such_fixture");
     assert_int_equal(murk_plugin_open(missing, 0, &p, err, sizeof err), -1);
     assert_contains(err, missing);
-    assert_contains(err, "cannot load:");
+    assert_contains(err, "cannot read: No such file");
     /* a text file named .so */
     const char *txt = write_tmp("text.so", "this is not an ELF file\n");
     assert_int_equal(murk_plugin_open(txt, 0, &p, err, sizeof err), -1);
-    assert_contains(err, "cannot load:");
+    assert_contains(err, "not an ELF shared object");
+    /* another major ABI with an aborting constructor: refused from the symbol table, never loaded */
+    const char *ctor = fixture("abi_ctor");
+    assert_int_equal(murk_plugin_open(ctor, 0, &p, err, sizeof err), -1);
+    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.0");
     assert_null(strchr(err, '\n'));
 }
 
