@@ -477,13 +477,11 @@ static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *e
 
 static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *err, size_t errlen)
 {
-    static const char *const common[] = {"type", "material", "emission", "interior", "exterior"};
     static const char *const quad_keys[] = {"type", "material", "emission", "interior", "exterior", "center", "u", "v"};
     static const char *const sphere_keys[] = {"type", "material", "emission", "interior", "exterior", "center", "radius"};
     static const char *const box_keys[] = {"type", "material", "emission", "interior", "exterior", "min", "max"};
     static const char *const mesh_keys[] = {"type", "material", "emission", "interior", "exterior", "file", "transform"};
     static const char *const types[] = {"quad", "sphere", "box", "mesh"};
-    (void)common;
     if (murk_yexpect_map(n, "a shape", err, errlen))
         return -1;
     const murk_ynode *t = murk_yrequire(n, "type", "shape", err, errlen);
