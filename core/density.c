@@ -205,7 +205,8 @@ murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi,
 
 #define VOL_HEADER 48
 
-murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
+/* Opens a regular file for reading and gives its size; NULL with err set otherwise. */
+static FILE *open_regular(const char *path, uint64_t *size, char *err, size_t errlen)
 {
     FILE *fp = fopen(path, "rb");
     if (!fp) {
@@ -218,7 +219,16 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
         fclose(fp);
         return NULL;
     }
-    uint64_t fsize = (uint64_t)st.st_size;
+    *size = (uint64_t)st.st_size;
+    return fp;
+}
+
+murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
+{
+    uint64_t fsize;
+    FILE *fp = open_regular(path, &fsize, err, errlen);
+    if (!fp)
+        return NULL;
     unsigned char h[VOL_HEADER];
     size_t got = fread(h, 1, sizeof h, fp);
     if (got >= 3 && memcmp(h, "VOL", 3) != 0) {
@@ -395,18 +405,9 @@ static uint64_t bswap64(uint64_t v)
 /* Reads a whole file; returns the malloc'd bytes (NULL with err set on failure). */
 static unsigned char *read_all(const char *path, uint64_t *size, char *err, size_t errlen)
 {
-    FILE *fp = fopen(path, "rb");
-    if (!fp) {
-        seterr(err, errlen, "%s: %s", path, strerror(errno));
+    FILE *fp = open_regular(path, size, err, errlen);
+    if (!fp)
         return NULL;
-    }
-    struct stat st;
-    if (fstat(fileno(fp), &st) != 0 || !S_ISREG(st.st_mode)) {
-        seterr(err, errlen, "%s: not a regular file", path);
-        fclose(fp);
-        return NULL;
-    }
-    *size = (uint64_t)st.st_size;
     if (*size > (uint64_t)SIZE_MAX - 8) {
         seterr(err, errlen, "%s: file too large", path);
         fclose(fp);
