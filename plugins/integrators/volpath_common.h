@@ -59,10 +59,11 @@ static void volpath_destroy(void *self)
         v->host->free(v);
 }
 
+static float vp_maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
+
 static murk_vec3 vp_offset(murk_vec3 p, murk_vec3 n, murk_vec3 dir)
 {
-    float m = murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z)));
-    float eps = 1e-4f * murk_maxf(1.0f, m);
+    float eps = 1e-4f * murk_maxf(1.0f, vp_maxabs(p));
     return murk_madd(p, n, murk_dot(n, dir) >= 0.0f ? eps : -eps);
 }
 
@@ -74,51 +75,52 @@ static float vp_power(float a, float b)
 
 static float vp_mean(murk_rgb r) { return (r.c[0] + r.c[1] + r.c[2]) * (1.0f / 3.0f); }
 
-/* 1 if nothing but index-matched boundaries lies between p and the light point at distance dist. */
-static float vp_unoccluded(const volpath *v, const murk_scene *scene, murk_vec3 p, murk_vec3 n, murk_vec3 w, float dist)
-{
-    murk_ray r;
-    r.o = vp_offset(p, n, w);
-    r.d = w;
-    r.tmin = 0.0f;
-    r.tmax = dist * (1.0f - 1e-3f);
-    return v->host->occluded(scene, &r) ? 0.0f : 1.0f;
-}
-
-/* Transmittance from p along unit w to the light point at distance dist, starting in medium m and
- * crossing index-matched boundaries; 0 if a surface with a material blocks the way. offset_n: the
- * normal to offset a surface point along (a zero vector for a point inside a medium). */
-static murk_rgb vp_transmittance(const volpath *v, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n,
-                                 murk_vec3 w, float dist, const murk_medium *m, const murk_path_ctx *ctx,
-                                 murk_rng *rng)
+/* Transmittance of a shadow ray from p to the light point q: 0 if a surface with a material blocks
+ * the way, otherwise the product of the media's transmittance() estimates over the legs between
+ * index-matched boundaries (with media = 0 boundaries are passed and media ignored, as the `path`
+ * integrator's own paths do). m: the medium at p. offset_n: the normal to offset a surface point
+ * along (a zero vector for a point inside a medium).
+ *
+ * Every leg is aimed at q itself: after a boundary the ray restarts just beyond it (offset along the
+ * boundary's normal) with its direction and length recomputed towards q, and it stops 1e-4 x |q|
+ * short of q. An offset origin is off the original line, so a leg that kept the first direction and
+ * a length measured along it would reach a light parallel to the boundary early and count the light
+ * itself as an occluder. */
+static murk_rgb vp_shadow(const volpath *v, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
+                          const murk_medium *m, int media, const murk_path_ctx *ctx, murk_rng *rng)
 {
     const murk_host *h = v->host;
+    const float end_eps = 1e-4f * murk_maxf(1.0f, vp_maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
-    murk_vec3 target = murk_madd(p, w, dist);
-    murk_ray r;
-    r.o = murk_dot(offset_n, offset_n) > 0.0f ? vp_offset(p, offset_n, w) : p;
-    r.d = w;
+    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? vp_offset(p, offset_n, murk_sub(q, p)) : p;
     for (int crossings = 0; crossings < 256; crossings++) {
-        float left = murk_dot(murk_sub(target, r.o), w) * (1.0f - 1e-4f);
-        if (left <= 0.0f)
+        murk_vec3 d = murk_sub(q, o);
+        float len = murk_length(d);
+        if (!(len > end_eps))
             return T;
+        murk_ray r;
+        r.o = o;
+        r.d = murk_mul(d, 1.0f / len);
         r.tmin = 0.0f;
-        r.tmax = left;
+        r.tmax = len - end_eps;
+        if (!m && !h->occluded(scene, &r)) /* nothing at all in the way: the common case, cheaply */
+            return T;
         murk_hit hit;
         int found = h->intersect(scene, &r, &hit);
         if (found && hit.material)
             return murk_rgb1(0.0f);
         if (m) {
             murk_ray s = r;
-            s.tmax = found ? hit.t : left;
+            s.tmax = found ? hit.t : r.tmax;
             T = murk_rgb_mul(T, m->vt->transmittance(m->self, &s, ctx, rng));
             if (murk_rgb_is_black(T))
                 return T;
         }
         if (!found)
             return T;
-        m = murk_dot(w, hit.ng) < 0.0f ? hit.interior : hit.exterior;
-        r.o = vp_offset(hit.p, hit.ng, w);
+        if (media)
+            m = murk_dot(r.d, hit.ng) < 0.0f ? hit.interior : hit.exterior;
+        o = vp_offset(hit.p, hit.ng, r.d);
     }
     return murk_rgb1(0.0f);
 }
@@ -160,7 +162,7 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
                     murk_light_sample ls;
                     if (h->sample_light(scene, p, ul, &ls)) {
                         float ph = h->phase_eval(g, wo, ls.wi);
-                        murk_rgb T = vp_transmittance(v, scene, p, murk_v3(0, 0, 0), ls.wi, ls.dist, medium, &ctx, rng);
+                        murk_rgb T = vp_shadow(v, scene, p, murk_v3(0, 0, 0), murk_madd(p, ls.wi, ls.dist), medium, 1, &ctx, rng);
                         if (!murk_rgb_is_black(T)) {
                             float w = vp_power(ls.pdf, ph) * ph / ls.pdf / vp_mean(R);
                             L = murk_rgb_add(L, murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(beta, T), ls.le), w));
@@ -224,8 +226,8 @@ static murk_rgb volpath_li_impl(const volpath *v, const murk_scene *scene, const
                     murk_vec3 wi = murk_to_local(ls.wi, t, b, n);
                     murk_rgb f = m->vt->eval(m->self, &hit, wo, wi);
                     if (!murk_rgb_is_black(f)) {
-                        murk_rgb T = media ? vp_transmittance(v, scene, hit.p, ng, ls.wi, ls.dist, medium, &ctx, rng)
-                                           : murk_rgb1(vp_unoccluded(v, scene, hit.p, ng, ls.wi, ls.dist));
+                        murk_rgb T = vp_shadow(v, scene, hit.p, ng, murk_madd(hit.p, ls.wi, ls.dist), medium, media,
+                                               &ctx, rng);
                         if (!murk_rgb_is_black(T)) {
                             float w = vp_power(ls.pdf, m->vt->pdf(m->self, &hit, wo, wi));
                             float k = fabsf(wi.z) * w / ls.pdf / vp_mean(R);
