@@ -9,7 +9,7 @@
 
 static int quiet;
 
-void *murk_xmalloc(size_t n)
+MURK_API void *murk_xmalloc(size_t n)
 {
     void *p = calloc(1, n ? n : 1);
     if (!p) {
@@ -19,7 +19,7 @@ void *murk_xmalloc(size_t n)
     return p;
 }
 
-void *murk_xrealloc(void *p, size_t n)
+MURK_API void *murk_xrealloc(void *p, size_t n)
 {
     void *q = realloc(p, n ? n : 1);
     if (!q) {
@@ -29,7 +29,7 @@ void *murk_xrealloc(void *p, size_t n)
     return q;
 }
 
-char *murk_strdup(const char *s)
+MURK_API char *murk_strdup(const char *s)
 {
     size_t n = strlen(s) + 1;
     char *d = murk_xmalloc(n);
@@ -107,9 +107,9 @@ double murk_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-void murk_set_quiet(int q) { quiet = q; }
+MURK_API void murk_set_quiet(int q) { quiet = q; }
 
-void murk_log(int level, const char *fmt, ...)
+MURK_API void murk_log(int level, const char *fmt, ...)
 {
     if (quiet && level == MURK_LOG_INFO)
         return;

@@ -3,8 +3,9 @@
  *   murk plugins [NAME]
  *   murk compare A.exr B.exr [--diff d.png]
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
+ * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "host.h"
+#include "cli.h"
 #include "density.h"
 #include "image.h"
 #include "media.h"
@@ -480,7 +481,7 @@ static int cmd_grid(int argc, char **argv)
     return rc ? 1 : 0;
 }
 
-MURK_API int murk_cli_main(int argc, char **argv)
+int murk_cli_main(int argc, char **argv)
 {
     if (argc < 2)
         return usage(NULL);

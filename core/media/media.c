@@ -89,7 +89,7 @@ void murk_warn_once(const char *fmt, ...)
     pthread_mutex_unlock(&warn_lock);
 }
 
-void murk_warn_summary(void)
+MURK_API void murk_warn_summary(void)
 {
     pthread_mutex_lock(&warn_lock);
     for (int i = 0; i < nwarned; i++) {

@@ -10,6 +10,7 @@
  *         grid buffer is read with PNanoVDB (the C port of NanoVDB), bounds-checked, so a corrupt
  *         file yields zeros or an error rather than a wild read. */
 #include "density.h"
+#include "util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -309,7 +310,7 @@ fail:
     return NULL;
 }
 
-int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
+MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
 {
     if (!f || f->kind != FIELD_GRID) {
         seterr(err, errlen, "%s: only grid fields can be saved as .vol (this one is constant)", path);
@@ -736,7 +737,7 @@ static double smoothstep01(double a, double b, double x)
     return t * t * (3.0 - 2.0 * t);
 }
 
-murk_field *murk_field_cloud(murk_vec3 lo, murk_vec3 hi, int res, uint64_t seed, float frequency, int octaves,
+MURK_API murk_field *murk_field_cloud(murk_vec3 lo, murk_vec3 hi, int res, uint64_t seed, float frequency, int octaves,
                              float coverage)
 {
     if (!box_ok(lo, hi) || res < 2 || res > 1024 || !(frequency > 0.0f) || !isfinite(frequency) || octaves < 1 ||
@@ -849,7 +850,7 @@ void murk_field_bounds(const murk_field *f, murk_vec3 *lo, murk_vec3 *hi, int *i
         *infinite = f->kind == FIELD_CONSTANT;
 }
 
-float murk_field_max(const murk_field *f) { return f->vmax; }
+MURK_API float murk_field_max(const murk_field *f) { return f->vmax; }
 float murk_field_min(const murk_field *f) { return f->vmin; }
 
 void murk_field_grid(const murk_field *f, int res[3], const float **data)
@@ -860,7 +861,7 @@ void murk_field_grid(const murk_field *f, int res[3], const float **data)
         *data = f->data;
 }
 
-void murk_field_free(murk_field *f)
+MURK_API void murk_field_free(murk_field *f)
 {
     if (!f)
         return;

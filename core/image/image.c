@@ -20,6 +20,7 @@
  * message names the failing step plus the library's text for the result code. libpng errors
  * longjmp back into small functions whose caller owns every resource, so nothing leaks. */
 #include "image.h"
+#include "util.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -116,7 +117,7 @@ const char *murk_image_meta(const murk_image *img, const char *key)
     return NULL;
 }
 
-void murk_image_free(murk_image *img)
+MURK_API void murk_image_free(murk_image *img)
 {
     if (!img)
         return;
@@ -364,7 +365,7 @@ static int exr_verify(const char *tmp, const float *rgb, int w, int h)
     return same;
 }
 
-int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_kv *meta, int nmeta,
+MURK_API int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_kv *meta, int nmeta,
                    char *err, size_t errlen)
 {
     if (!path || !rgb || !size_ok(w, h) || nmeta < 0 || (nmeta > 0 && !meta))
@@ -571,7 +572,7 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
     return rc;
 }
 
-int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen)
+MURK_API int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen)
 {
     if (!img)
         return fail(err, errlen, "%s: no image to read into", path ? path : "(null)");
@@ -665,7 +666,7 @@ static int png_encode(png_job *j, const float *rgb, int w, int h, double scale)
     return 0;
 }
 
-int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen)
+MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen)
 {
     if (!path || !rgb || !size_ok(w, h))
         return fail(err, errlen, "%s: invalid image (%dx%d)", path ? path : "(null)", w, h);
