@@ -20,6 +20,7 @@
  * message names the failing step plus the library's text for the result code. libpng errors
  * longjmp back into small functions whose caller owns every resource, so nothing leaks. */
 #include "image.h"
+#include "error.h"
 #include "util.h"
 
 #include <errno.h>
@@ -38,28 +39,8 @@
 #include <openexr.h>
 #include <png.h>
 
-#ifndef MURK_PRINTF /* as in murk/plugin.h */
-#if defined(__GNUC__) || defined(__clang__)
-#define MURK_PRINTF(a, b) __attribute__((format(printf, a, b)))
-#else
-#define MURK_PRINTF(a, b)
-#endif
-#endif
-
 /* ---------------------------------------------------------------------------------------------- */
 /* Shared helpers                                                                                   */
-
-MURK_PRINTF(3, 4)
-static int fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (err && errlen > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 /* PATH.tmp-PID, malloc'd; NULL when out of memory. */
 static char *tmp_name(const char *path)
@@ -93,9 +74,9 @@ static int sync_close(int fd, const char *tmp, const char *path, char *err, size
 {
     int rc = 0;
     if (fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        rc = fail(err, errlen, "%s: cannot sync %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot sync %s: %s", tmp, strerror(errno));
     if (close(fd) != 0 && rc == 0)
-        rc = fail(err, errlen, "%s: cannot close %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot close %s: %s", tmp, strerror(errno));
     return rc;
 }
 
@@ -103,7 +84,7 @@ static int sync_close(int fd, const char *tmp, const char *path, char *err, size
 static int commit_tmp(int rc, const char *tmp, const char *path, char *err, size_t errlen)
 {
     if (rc == 0 && rename(tmp, path) != 0)
-        rc = fail(err, errlen, "%s: cannot rename %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot rename %s: %s", tmp, strerror(errno));
     if (rc != 0)
         unlink(tmp);
     return rc;
@@ -338,15 +319,15 @@ static int exr_write_tmp(const char *path, const char *tmp, const float *rgb, in
     memset(&io, 0, sizeof io);
     io.fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (io.fd < 0)
-        return fail(err, errlen, "%s: cannot create %s: %s", path, tmp, strerror(errno));
+        return murk_err_file(err, errlen, path, "cannot create %s: %s", tmp, strerror(errno));
     const char *step = "", *what = NULL;
     exr_result_t rv = exr_write_file(&io, tmp, rgb, w, h, meta, nmeta, comp, &step, &what);
     if (rv != EXR_ERR_SUCCESS) {
         const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
         if (what)
-            fail(err, errlen, "%s: EXR error %s '%.64s': %s", path, step, what, why);
+            murk_err_file(err, errlen, path, "EXR error %s '%.64s': %s", step, what, why);
         else
-            fail(err, errlen, "%s: EXR error %s: %s", path, step, why);
+            murk_err_file(err, errlen, path, "EXR error %s: %s", step, why);
         close(io.fd);
         return -1;
     }
@@ -369,10 +350,10 @@ MURK_API int murk_exr_write(const char *path, const float *rgb, int w, int h, co
                    char *err, size_t errlen)
 {
     if (!path || !rgb || !size_ok(w, h) || nmeta < 0 || (nmeta > 0 && !meta))
-        return fail(err, errlen, "%s: invalid image (%dx%d)", path ? path : "(null)", w, h);
+        return murk_err_file(err, errlen, path ? path : "(null)", "invalid image (%dx%d)", w, h);
     char *tmp = tmp_name(path);
     if (!tmp)
-        return fail(err, errlen, "%s: out of memory", path);
+        return murk_err_file(err, errlen, path, "out of memory");
     /* ZIP, read back and checked bit for bit: OpenEXRCore 3.1's ZIP encoder can store a chunk whose
      * zlib output is as large as its input in a form its decoder misreads (openexr issue 2306). If
      * the check fails, the file is written again uncompressed. */
@@ -380,7 +361,7 @@ MURK_API int murk_exr_write(const char *path, const float *rgb, int w, int h, co
     if (rc == 0 && !exr_verify(tmp, rgb, w, h))
         rc = exr_write_tmp(path, tmp, rgb, w, h, meta, nmeta, EXR_COMPRESSION_NONE, err, errlen);
     if (rc == 0 && !exr_verify(tmp, rgb, w, h))
-        rc = fail(err, errlen, "%s: the EXR written does not read back identically", path);
+        rc = murk_err_file(err, errlen, path, "the EXR written does not read back identically");
     rc = commit_tmp(rc, tmp, path, err, errlen);
     free(tmp);
     return rc;
@@ -506,22 +487,22 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
     exr_result_t rv;
 
     if (exr_get_count(ctx, &nparts) != EXR_ERR_SUCCESS || nparts < 1)
-        return fail(err, errlen, "%s: EXR file has no parts", path);
+        return murk_err_file(err, errlen, path, "EXR file has no parts");
     if (exr_get_storage(ctx, 0, &storage) != EXR_ERR_SUCCESS ||
         (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED))
-        return fail(err, errlen, "%s: deep EXR images are not supported", path);
+        return murk_err_file(err, errlen, path, "deep EXR images are not supported");
     if (exr_get_data_window(ctx, 0, &dw) != EXR_ERR_SUCCESS ||
         exr_get_channels(ctx, 0, &chl) != EXR_ERR_SUCCESS || !chl)
-        return fail(err, errlen, "%s: EXR header lacks a data window or channel list", path);
+        return murk_err_file(err, errlen, path, "EXR header lacks a data window or channel list");
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
     if (!size_ok(w, h))
-        return fail(err, errlen, "%s: unsupported EXR size %lldx%lld", path, (long long)w, (long long)h);
+        return murk_err_file(err, errlen, path, "unsupported EXR size %lldx%lld", (long long)w, (long long)h);
 
     /* Map file channels to RGB slots: R, G, B if all three exist, else Y into slot 0. */
     int nch = chl->num_channels, found = 0, y_ch = -1;
     int *slots = malloc(sizeof *slots * (size_t)(nch > 0 ? nch : 1));
     if (!slots)
-        return fail(err, errlen, "%s: out of memory", path);
+        return murk_err_file(err, errlen, path, "out of memory");
     for (int c = 0; c < nch; c++) {
         slots[c] = rgb_slot(chl->entries[c].name.str);
         if (slots[c] >= 0)
@@ -535,22 +516,22 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
     }
     int rc = 0;
     if (found != 7 && y_ch < 0)
-        rc = fail(err, errlen, "%s: EXR has neither R, G, B nor Y channels", path);
+        rc = murk_err_file(err, errlen, path, "EXR has neither R, G, B nor Y channels");
     for (int c = 0; c < nch && rc == 0; c++) {
         const exr_attr_chlist_entry_t *e = &chl->entries[c];
         if (slots[c] < 0)
             continue;
         if (e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT)
-            rc = fail(err, errlen, "%s: EXR channel %s is not half or float", path, e->name.str);
+            rc = murk_err_file(err, errlen, path, "EXR channel %s is not half or float", e->name.str);
         else if (e->x_sampling != 1 || e->y_sampling != 1)
-            rc = fail(err, errlen, "%s: EXR channel %s is subsampled", path, e->name.str);
+            rc = murk_err_file(err, errlen, path, "EXR channel %s is subsampled", e->name.str);
     }
     if (rc == 0) {
         img->w = (int)w;
         img->h = (int)h;
         img->rgb = calloc((size_t)w * (size_t)h * 3, sizeof(float));
         if (!img->rgb)
-            rc = fail(err, errlen, "%s: out of memory", path);
+            rc = murk_err_file(err, errlen, path, "out of memory");
     }
     if (rc == 0) {
         rv = exr_read_pixels(ctx, storage, &dw, slots, img->rgb, (int)w, (int)h);
@@ -558,7 +539,7 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
             const char *why = io->err     ? strerror(io->err)
                               : io->msg[0] ? io->msg
                                            : exr_get_default_error_message(rv);
-            rc = fail(err, errlen, "%s: cannot decode EXR pixels: %s", path, why);
+            rc = murk_err_file(err, errlen, path, "cannot decode EXR pixels: %s", why);
         }
     }
     if (rc == 0 && found != 7) {
@@ -567,7 +548,7 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
             img->rgb[3 * i + 1] = img->rgb[3 * i + 2] = img->rgb[3 * i];
     }
     if (rc == 0 && exr_read_meta(ctx, img) != 0)
-        rc = fail(err, errlen, "%s: out of memory", path);
+        rc = murk_err_file(err, errlen, path, "out of memory");
     free(slots);
     return rc;
 }
@@ -575,15 +556,15 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
 MURK_API int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen)
 {
     if (!img)
-        return fail(err, errlen, "%s: no image to read into", path ? path : "(null)");
+        return murk_err_file(err, errlen, path ? path : "(null)", "no image to read into");
     memset(img, 0, sizeof *img);
     if (!path)
-        return fail(err, errlen, "(null): no path");
+        return murk_err_file(err, errlen, "(null)", "no path");
     exr_io io;
     memset(&io, 0, sizeof io);
     io.fd = open(path, O_RDONLY | O_CLOEXEC);
     if (io.fd < 0)
-        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
 
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_read_error_cb;
@@ -596,7 +577,7 @@ MURK_API int murk_exr_read(const char *path, murk_image *img, char *err, size_t 
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         const char *why = io.err ? strerror(io.err) : io.msg[0] ? io.msg : exr_get_default_error_message(rv);
-        rc = fail(err, errlen, "%s: not a readable EXR file: %s", path, why);
+        rc = murk_err_file(err, errlen, path, "not a readable EXR file: %s", why);
     } else {
         rc = exr_read_image(ctx, &io, path, img, err, errlen);
     }
@@ -669,15 +650,15 @@ static int png_encode(png_job *j, const float *rgb, int w, int h, double scale)
 MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen)
 {
     if (!path || !rgb || !size_ok(w, h))
-        return fail(err, errlen, "%s: invalid image (%dx%d)", path ? path : "(null)", w, h);
+        return murk_err_file(err, errlen, path ? path : "(null)", "invalid image (%dx%d)", w, h);
     char *tmp = tmp_name(path);
     if (!tmp)
-        return fail(err, errlen, "%s: out of memory", path);
+        return murk_err_file(err, errlen, path, "out of memory");
     png_job j;
     memset(&j, 0, sizeof j);
     int rc = 0, fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) {
-        fail(err, errlen, "%s: cannot create %s: %s", path, tmp, strerror(errno));
+        murk_err_file(err, errlen, path, "cannot create %s: %s", tmp, strerror(errno));
         free(tmp);
         return -1;
     }
@@ -688,19 +669,19 @@ MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, fl
     if (j.png)
         j.info = png_create_info_struct(j.png);
     if (!j.fp || !j.pix || !j.png || !j.info)
-        rc = fail(err, errlen, "%s: out of memory", path);
+        rc = murk_err_file(err, errlen, path, "out of memory");
     else if (png_encode(&j, rgb, w, h, exp2((double)exposure)) != 0)
-        rc = fail(err, errlen, "%s: cannot write PNG: %s", path, j.msg[0] ? j.msg : "libpng error");
+        rc = murk_err_file(err, errlen, path, "cannot write PNG: %s", j.msg[0] ? j.msg : "libpng error");
     if (j.png)
         png_destroy_write_struct(&j.png, j.info ? &j.info : NULL);
     free(j.pix);
     if (rc == 0 && (fflush(j.fp) != 0 || ferror(j.fp)))
-        rc = fail(err, errlen, "%s: cannot write %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot write %s: %s", tmp, strerror(errno));
     if (rc == 0 && fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        rc = fail(err, errlen, "%s: cannot sync %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot sync %s: %s", tmp, strerror(errno));
     int closed = j.fp ? fclose(j.fp) : close(fd);
     if (closed != 0 && rc == 0)
-        rc = fail(err, errlen, "%s: cannot close %s: %s", path, tmp, strerror(errno));
+        rc = murk_err_file(err, errlen, path, "cannot close %s: %s", tmp, strerror(errno));
     rc = commit_tmp(rc, tmp, path, err, errlen);
     free(tmp);
     return rc;
@@ -751,32 +732,32 @@ static int png_decode(png_job *j)
 int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
 {
     if (!img)
-        return fail(err, errlen, "%s: no image to read into", path ? path : "(null)");
+        return murk_err_file(err, errlen, path ? path : "(null)", "no image to read into");
     memset(img, 0, sizeof *img);
     if (!path)
-        return fail(err, errlen, "(null): no path");
+        return murk_err_file(err, errlen, "(null)", "no path");
     png_job j;
     memset(&j, 0, sizeof j);
     int rc = 0, fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0)
-        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
     j.fp = fdopen(fd, "rb");
     if (!j.fp) {
         close(fd);
-        return fail(err, errlen, "%s: out of memory", path);
+        return murk_err_file(err, errlen, path, "out of memory");
     }
     unsigned char sig[8];
     if (fread(sig, 1, sizeof sig, j.fp) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         fclose(j.fp);
-        return fail(err, errlen, "%s: not a PNG file", path);
+        return murk_err_file(err, errlen, path, "not a PNG file");
     }
     j.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &j, png_error_cb, png_warning_cb);
     if (j.png)
         j.info = png_create_info_struct(j.png);
     if (!j.png || !j.info)
-        rc = fail(err, errlen, "%s: out of memory", path);
+        rc = murk_err_file(err, errlen, path, "out of memory");
     else if (png_decode(&j) != 0)
-        rc = fail(err, errlen, "%s: cannot read PNG: %s", path, j.msg[0] ? j.msg : "libpng error");
+        rc = murk_err_file(err, errlen, path, "cannot read PNG: %s", j.msg[0] ? j.msg : "libpng error");
     if (j.png)
         png_destroy_read_struct(&j.png, j.info ? &j.info : NULL, NULL);
     fclose(j.fp);
@@ -785,7 +766,7 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
         size_t n = (size_t)j.w * (size_t)j.h * 3;
         img->rgb = malloc(n * sizeof(float));
         if (!img->rgb) {
-            rc = fail(err, errlen, "%s: out of memory", path);
+            rc = murk_err_file(err, errlen, path, "out of memory");
         } else {
             float lut[256];
             for (int v = 0; v < 256; v++) {

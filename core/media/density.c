@@ -10,6 +10,7 @@
  *         grid buffer is read with PNanoVDB (the C port of NanoVDB), bounds-checked, so a corrupt
  *         file yields zeros or an error rather than a wild read. */
 #include "density.h"
+#include "error.h"
 #include "util.h"
 
 #include <errno.h>
@@ -55,16 +56,6 @@ struct murk_field {
     float *data;
     float vmin, vmax;     /* voxel extremes */
 };
-
-static void seterr(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (!err || errlen == 0)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
 
 static float v3get(murk_vec3 v, int a) { return a == 0 ? v.x : (a == 1 ? v.y : v.z); }
 
@@ -179,9 +170,7 @@ static int check_values(const char *path, const float *data, const int res[3], c
                 float v = data[i];
                 if (isfinite(v) && v >= 0.0f)
                     continue;
-                seterr(err, errlen, "%s: %s %g at voxel (%d, %d, %d); densities must be finite and >= 0", path,
-                       isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative density"), (double)v,
-                       x + origin[0], y + origin[1], z + origin[2]);
+                murk_err_file(err, errlen, path, "%s %g at voxel (%d, %d, %d); densities must be finite and >= 0", isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative density"), (double)v, x + origin[0], y + origin[1], z + origin[2]);
                 return -1;
             }
     return 0;
@@ -211,12 +200,12 @@ static FILE *open_regular(const char *path, uint64_t *size, char *err, size_t er
 {
     FILE *fp = fopen(path, "rb");
     if (!fp) {
-        seterr(err, errlen, "%s: %s", path, strerror(errno));
+        murk_err_file(err, errlen, path, "%s", strerror(errno));
         return NULL;
     }
     struct stat st;
     if (fstat(fileno(fp), &st) != 0 || !S_ISREG(st.st_mode)) {
-        seterr(err, errlen, "%s: not a regular file", path);
+        murk_err_file(err, errlen, path, "not a regular file");
         fclose(fp);
         return NULL;
     }
@@ -233,20 +222,20 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
     unsigned char h[VOL_HEADER];
     size_t got = fread(h, 1, sizeof h, fp);
     if (got >= 3 && memcmp(h, "VOL", 3) != 0) {
-        seterr(err, errlen, "%s: not a .vol file (bad magic; expected 'VOL')", path);
+        murk_err_file(err, errlen, path, "not a .vol file (bad magic; expected 'VOL')");
         goto fail;
     }
     if (got < sizeof h) {
-        seterr(err, errlen, "%s: truncated header (%zu bytes; a .vol header has %d)", path, got, VOL_HEADER);
+        murk_err_file(err, errlen, path, "truncated header (%zu bytes; a .vol header has %d)", got, VOL_HEADER);
         goto fail;
     }
     if (h[3] != 3) {
-        seterr(err, errlen, "%s: unsupported .vol version %d (murk reads version 3)", path, h[3]);
+        murk_err_file(err, errlen, path, "unsupported .vol version %d (murk reads version 3)", h[3]);
         goto fail;
     }
     int32_t enc = (int32_t)rd_u32(h + 4);
     if (enc != 1) {
-        seterr(err, errlen, "%s: unsupported .vol encoding %d (murk reads 1 = float32)", path, (int)enc);
+        murk_err_file(err, errlen, path, "unsupported .vol encoding %d (murk reads 1 = float32)", (int)enc);
         goto fail;
     }
     int32_t rx = (int32_t)rd_u32(h + 8), ry = (int32_t)rd_u32(h + 12), rz = (int32_t)rd_u32(h + 16);
@@ -254,41 +243,37 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
     uint64_t n = voxel_count(rx, ry, rz);
     if (n == 0) {
         if (rx < 1 || ry < 1 || rz < 1)
-            seterr(err, errlen, "%s: bad resolution %d x %d x %d", path, (int)rx, (int)ry, (int)rz);
+            murk_err_file(err, errlen, path, "bad resolution %d x %d x %d", (int)rx, (int)ry, (int)rz);
         else
-            seterr(err, errlen, "%s: resolution %d x %d x %d exceeds the limit of %llu voxels", path, (int)rx,
-                   (int)ry, (int)rz, (unsigned long long)MURK_FIELD_MAX_VOXELS);
+            murk_err_file(err, errlen, path, "resolution %d x %d x %d exceeds the limit of %llu voxels", (int)rx, (int)ry, (int)rz, (unsigned long long)MURK_FIELD_MAX_VOXELS);
         goto fail;
     }
     if (ch != 1) {
-        seterr(err, errlen, "%s: %d channels; a density grid needs exactly 1 (extract one channel)", path, (int)ch);
+        murk_err_file(err, errlen, path, "%d channels; a density grid needs exactly 1 (extract one channel)", (int)ch);
         goto fail;
     }
     murk_vec3 lo = murk_v3(rd_f32(h + 24), rd_f32(h + 28), rd_f32(h + 32));
     murk_vec3 hi = murk_v3(rd_f32(h + 36), rd_f32(h + 40), rd_f32(h + 44));
     if (!box_ok(lo, hi)) {
-        seterr(err, errlen, "%s: bad bounding box (%g %g %g)-(%g %g %g); need finite min < max on every axis", path,
-               (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
+        murk_err_file(err, errlen, path, "bad bounding box (%g %g %g)-(%g %g %g); need finite min < max on every axis", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
         goto fail;
     }
     uint64_t want = n * 4u, have = fsize - VOL_HEADER;
     if (have < want) {
-        seterr(err, errlen, "%s: truncated data: %d x %d x %d voxels need %llu bytes, the file holds %llu", path,
-               (int)rx, (int)ry, (int)rz, (unsigned long long)want, (unsigned long long)have);
+        murk_err_file(err, errlen, path, "truncated data: %d x %d x %d voxels need %llu bytes, the file holds %llu", (int)rx, (int)ry, (int)rz, (unsigned long long)want, (unsigned long long)have);
         goto fail;
     }
     if (have > want) {
-        seterr(err, errlen, "%s: %llu bytes after the data (does the header's resolution %d x %d x %d match?)",
-               path, (unsigned long long)(have - want), (int)rx, (int)ry, (int)rz);
+        murk_err_file(err, errlen, path, "%llu bytes after the data (does the header's resolution %d x %d x %d match?)", (unsigned long long)(have - want), (int)rx, (int)ry, (int)rz);
         goto fail;
     }
     float *data = malloc((size_t)n * sizeof *data);
     if (!data) {
-        seterr(err, errlen, "%s: out of memory for %llu voxels", path, (unsigned long long)n);
+        murk_err_file(err, errlen, path, "out of memory for %llu voxels", (unsigned long long)n);
         goto fail;
     }
     if (fread(data, 4, (size_t)n, fp) != (size_t)n) {
-        seterr(err, errlen, "%s: read error: %s", path, ferror(fp) ? strerror(errno) : "unexpected end of file");
+        murk_err_file(err, errlen, path, "read error: %s", ferror(fp) ? strerror(errno) : "unexpected end of file");
         free(data);
         goto fail;
     }
@@ -303,7 +288,7 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
     }
     murk_field *f = grid_new(res, lo, hi, data);
     if (!f)
-        seterr(err, errlen, "%s: out of memory", path);
+        murk_err_file(err, errlen, path, "out of memory");
     return f;
 fail:
     fclose(fp);
@@ -313,26 +298,26 @@ fail:
 MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
 {
     if (!f || f->kind != FIELD_GRID) {
-        seterr(err, errlen, "%s: only grid fields can be saved as .vol (this one is constant)", path);
+        murk_err_file(err, errlen, path, "only grid fields can be saved as .vol (this one is constant)");
         return -1;
     }
     size_t plen = strlen(path);
     char *tmp = malloc(plen + 16);
     if (!tmp) {
-        seterr(err, errlen, "%s: out of memory", path);
+        murk_err_file(err, errlen, path, "out of memory");
         return -1;
     }
     snprintf(tmp, plen + 16, "%s.tmp-XXXXXX", path);
     int fd = mkstemp(tmp);
     if (fd < 0) {
-        seterr(err, errlen, "%s: cannot create a temporary file: %s", path, strerror(errno));
+        murk_err_file(err, errlen, path, "cannot create a temporary file: %s", strerror(errno));
         free(tmp);
         return -1;
     }
     (void)fchmod(fd, 0644); /* mkstemp creates 0600; a saved grid is an ordinary file */
     FILE *fp = fdopen(fd, "wb");
     if (!fp) {
-        seterr(err, errlen, "%s: %s", path, strerror(errno));
+        murk_err_file(err, errlen, path, "%s", strerror(errno));
         close(fd);
         goto fail;
     }
@@ -366,11 +351,11 @@ MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *er
     if (!ok) {
         if (!saved_errno)
             saved_errno = errno;
-        seterr(err, errlen, "%s: write error: %s", path, saved_errno ? strerror(saved_errno) : "I/O error");
+        murk_err_file(err, errlen, path, "write error: %s", saved_errno ? strerror(saved_errno) : "I/O error");
         goto fail;
     }
     if (rename(tmp, path) != 0) {
-        seterr(err, errlen, "%s: %s", path, strerror(errno));
+        murk_err_file(err, errlen, path, "%s", strerror(errno));
         goto fail;
     }
     free(tmp);
@@ -410,18 +395,18 @@ static unsigned char *read_all(const char *path, uint64_t *size, char *err, size
     if (!fp)
         return NULL;
     if (*size > (uint64_t)SIZE_MAX - 8) {
-        seterr(err, errlen, "%s: file too large", path);
+        murk_err_file(err, errlen, path, "file too large");
         fclose(fp);
         return NULL;
     }
     unsigned char *b = malloc((size_t)*size + 8);
     if (!b) {
-        seterr(err, errlen, "%s: out of memory reading %llu bytes", path, (unsigned long long)*size);
+        murk_err_file(err, errlen, path, "out of memory reading %llu bytes", (unsigned long long)*size);
         fclose(fp);
         return NULL;
     }
     if (fread(b, 1, (size_t)*size, fp) != (size_t)*size) {
-        seterr(err, errlen, "%s: read error", path);
+        murk_err_file(err, errlen, path, "read error");
         free(b);
         fclose(fp);
         return NULL;
@@ -435,20 +420,20 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
                           char *err, size_t errlen)
 {
     if (size >= 4 && rd_u32(b) == 0x56444220u) {
-        seterr(err, errlen, "%s: an OpenVDB .vdb file, not NanoVDB (convert it with nanovdb_convert)", path);
+        murk_err_file(err, errlen, path, "an OpenVDB .vdb file, not NanoVDB (convert it with nanovdb_convert)");
         return -1;
     }
     if (size < 16) {
-        seterr(err, errlen, "%s: too short for a NanoVDB file (%llu bytes)", path, (unsigned long long)size);
+        murk_err_file(err, errlen, path, "too short for a NanoVDB file (%llu bytes)", (unsigned long long)size);
         return -1;
     }
     uint64_t magic = rd_u64(b);
     if (magic == bswap64(NVDB_MAGIC_NUMB) || magic == bswap64(NVDB_MAGIC_GRID) || magic == bswap64(NVDB_MAGIC_FILE)) {
-        seterr(err, errlen, "%s: big-endian NanoVDB file; murk reads little-endian only", path);
+        murk_err_file(err, errlen, path, "big-endian NanoVDB file; murk reads little-endian only");
         return -1;
     }
     if (magic != NVDB_MAGIC_NUMB && magic != NVDB_MAGIC_GRID && magic != NVDB_MAGIC_FILE) {
-        seterr(err, errlen, "%s: not a NanoVDB file (bad magic)", path);
+        murk_err_file(err, errlen, path, "not a NanoVDB file (bad magic)");
         return -1;
     }
     int raw = magic == NVDB_MAGIC_GRID ||
@@ -457,24 +442,22 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
     if (raw) { /* grid buffers back to back */
         for (uint64_t p = 0; p < size;) {
             if (size - p < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
-                seterr(err, errlen, "%s: truncated grid at byte %llu", path, (unsigned long long)p);
+                murk_err_file(err, errlen, path, "truncated grid at byte %llu", (unsigned long long)p);
                 return -1;
             }
             uint64_t m = rd_u64(b + p);
             uint32_t ver = rd_u32(b + p + 16);
             uint64_t gsize = rd_u64(b + p + 32);
             if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_GRID) {
-                seterr(err, errlen, "%s: bad grid magic at byte %llu", path, (unsigned long long)p);
+                murk_err_file(err, errlen, path, "bad grid magic at byte %llu", (unsigned long long)p);
                 return -1;
             }
             if (nvdb_major(ver) != NVDB_MAJOR) {
-                seterr(err, errlen, "%s: NanoVDB grid version %u.%u.%u; murk reads major version %u", path,
-                       nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
+                murk_err_file(err, errlen, path, "NanoVDB grid version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
                 return -1;
             }
             if (gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE || gsize > size - p) {
-                seterr(err, errlen, "%s: grid at byte %llu claims %llu bytes; %llu remain", path,
-                       (unsigned long long)p, (unsigned long long)gsize, (unsigned long long)(size - p));
+                murk_err_file(err, errlen, path, "grid at byte %llu claims %llu bytes; %llu remain", (unsigned long long)p, (unsigned long long)gsize, (unsigned long long)(size - p));
                 return -1;
             }
             if (rd_u32(b + p + 636) == NVDB_TYPE_FLOAT) {
@@ -484,12 +467,12 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
             }
             p += gsize;
         }
-        seterr(err, errlen, "%s: no float grid in the file", path);
+        murk_err_file(err, errlen, path, "no float grid in the file");
         return -1;
     }
     for (uint64_t p = 0; p < size;) { /* segments */
         if (size - p < 16) {
-            seterr(err, errlen, "%s: truncated segment header at byte %llu", path, (unsigned long long)p);
+            murk_err_file(err, errlen, path, "truncated segment header at byte %llu", (unsigned long long)p);
             return -1;
         }
         uint64_t m = rd_u64(b + p);
@@ -497,29 +480,28 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
         unsigned count = b[p + 12] | (unsigned)b[p + 13] << 8;
         unsigned codec = b[p + 14] | (unsigned)b[p + 15] << 8;
         if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_FILE) {
-            seterr(err, errlen, "%s: bad segment magic at byte %llu", path, (unsigned long long)p);
+            murk_err_file(err, errlen, path, "bad segment magic at byte %llu", (unsigned long long)p);
             return -1;
         }
         if (nvdb_major(ver) != NVDB_MAJOR) {
-            seterr(err, errlen, "%s: NanoVDB file version %u.%u.%u; murk reads major version %u", path,
-                   nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
+            murk_err_file(err, errlen, path, "NanoVDB file version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
             return -1;
         }
         if (codec != 0) {
-            seterr(err, errlen, "%s: grids compressed with %s; murk reads uncompressed NanoVDB files only (re-save "
-                   "it without compression)", path, codec == 1 ? "ZIP" : (codec == 2 ? "BLOSC" : "an unknown codec"));
+            murk_err_file(err, errlen, path, "grids compressed with %s; murk reads uncompressed NanoVDB files only (re-save "
+                   "it without compression)", codec == 1 ? "ZIP" : (codec == 2 ? "BLOSC" : "an unknown codec"));
             return -1;
         }
         /* First pass: find where the grid buffers start (after all metadata and names). */
         uint64_t q = p + 16;
         for (unsigned i = 0; i < count; i++) {
             if (size - q < NVDB_META_SIZE) {
-                seterr(err, errlen, "%s: truncated grid metadata at byte %llu", path, (unsigned long long)q);
+                murk_err_file(err, errlen, path, "truncated grid metadata at byte %llu", (unsigned long long)q);
                 return -1;
             }
             uint64_t name = rd_u32(b + q + 136);
             if (name > size - q - NVDB_META_SIZE) {
-                seterr(err, errlen, "%s: truncated grid name at byte %llu", path, (unsigned long long)q);
+                murk_err_file(err, errlen, path, "truncated grid name at byte %llu", (unsigned long long)q);
                 return -1;
             }
             q += NVDB_META_SIZE + name;
@@ -531,18 +513,16 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
             uint32_t type = rd_u32(b + meta + 32);
             unsigned mcodec = b[meta + 168] | (unsigned)b[meta + 169] << 8;
             if (mcodec != 0) {
-                seterr(err, errlen, "%s: grid %u is compressed; murk reads uncompressed NanoVDB files only", path, i);
+                murk_err_file(err, errlen, path, "grid %u is compressed; murk reads uncompressed NanoVDB files only", i);
                 return -1;
             }
             if (fsize > size - data) {
-                seterr(err, errlen, "%s: truncated: grid %u needs %llu bytes at byte %llu, %llu remain", path, i,
-                       (unsigned long long)fsize, (unsigned long long)data, (unsigned long long)(size - data));
+                murk_err_file(err, errlen, path, "truncated: grid %u needs %llu bytes at byte %llu, %llu remain", i, (unsigned long long)fsize, (unsigned long long)data, (unsigned long long)(size - data));
                 return -1;
             }
             if (type == NVDB_TYPE_FLOAT) {
                 if (gsize != fsize || gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
-                    seterr(err, errlen, "%s: grid %u has inconsistent sizes (%llu in memory, %llu on disk)", path, i,
-                           (unsigned long long)gsize, (unsigned long long)fsize);
+                    murk_err_file(err, errlen, path, "grid %u has inconsistent sizes (%llu in memory, %llu on disk)", i, (unsigned long long)gsize, (unsigned long long)fsize);
                     return -1;
                 }
                 *off = data;
@@ -554,7 +534,7 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
         }
         p = data;
     }
-    seterr(err, errlen, "%s: no float grid in the file", path);
+    murk_err_file(err, errlen, path, "no float grid in the file");
     return -1;
 }
 
@@ -565,15 +545,15 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     uint64_t m = rd_u64(g);
     uint32_t ver = rd_u32(g + 16);
     if ((m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_GRID) || nvdb_major(ver) != NVDB_MAJOR) {
-        seterr(err, errlen, "%s: bad grid header (magic or version)", path);
+        murk_err_file(err, errlen, path, "bad grid header (magic or version)");
         return NULL;
     }
     if (rd_u32(g + 636) != NVDB_TYPE_FLOAT) {
-        seterr(err, errlen, "%s: grid is not a float grid", path);
+        murk_err_file(err, errlen, path, "grid is not a float grid");
         return NULL;
     }
     if (rd_u32(g + 632) == NVDB_CLASS_LEVEL_SET) {
-        seterr(err, errlen, "%s: the float grid is a level set (signed distances), not a density (fog volume)", path);
+        murk_err_file(err, errlen, path, "the float grid is a level set (signed distances), not a density (fog volume)");
         return NULL;
     }
     /* Index-to-world map: double matrix (row-major) at 296+88, translation at 296+232. */
@@ -589,7 +569,7 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     for (int r = 0; r < 3; r++) {
         scale[r] = mat[4 * r];
         if (!isfinite(scale[r]) || !(scale[r] > 0.0) || !isfinite(vec[r])) {
-            seterr(err, errlen, "%s: unsupported index-to-world map (need a positive, finite scale per axis)", path);
+            murk_err_file(err, errlen, path, "unsupported index-to-world map (need a positive, finite scale per axis)");
             return NULL;
         }
     }
@@ -597,7 +577,7 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
             if (r != c && !(fabs(mat[3 * r + c]) <= 1e-9 * smax)) {
-                seterr(err, errlen, "%s: rotated or sheared index-to-world maps are not supported", path);
+                murk_err_file(err, errlen, path, "rotated or sheared index-to-world maps are not supported");
                 return NULL;
             }
 
@@ -607,24 +587,23 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     pnanovdb_root_handle_t root = pnanovdb_tree_get_root(buf, tree);
     uint64_t roff = root.address.byte_offset;
     if (roff < NVDB_GRID_SIZE + NVDB_TREE_SIZE || roff > len || len - roff < 64) {
-        seterr(err, errlen, "%s: corrupt grid (root node outside the buffer)", path);
+        murk_err_file(err, errlen, path, "corrupt grid (root node outside the buffer)");
         return NULL;
     }
     uint64_t tiles = pnanovdb_root_get_tile_count(buf, root);
     if (tiles > (len - roff - 64) / PNANOVDB_GRID_TYPE_GET(PNANOVDB_GRID_TYPE_FLOAT, root_tile_size)) {
-        seterr(err, errlen, "%s: corrupt grid (root tile table outside the buffer)", path);
+        murk_err_file(err, errlen, path, "corrupt grid (root tile table outside the buffer)");
         return NULL;
     }
     pnanovdb_coord_t bmin = pnanovdb_root_get_bbox_min(buf, root), bmax = pnanovdb_root_get_bbox_max(buf, root);
     int64_t r0 = (int64_t)bmax.x - bmin.x + 1, r1 = (int64_t)bmax.y - bmin.y + 1, r2 = (int64_t)bmax.z - bmin.z + 1;
     if (r0 < 1 || r1 < 1 || r2 < 1) {
-        seterr(err, errlen, "%s: the float grid has no active voxels", path);
+        murk_err_file(err, errlen, path, "the float grid has no active voxels");
         return NULL;
     }
     uint64_t n = voxel_count(r0, r1, r2);
     if (n == 0) {
-        seterr(err, errlen, "%s: active bounding box %lld x %lld x %lld exceeds the limit of %llu voxels", path,
-               (long long)r0, (long long)r1, (long long)r2, (unsigned long long)MURK_FIELD_MAX_VOXELS);
+        murk_err_file(err, errlen, path, "active bounding box %lld x %lld x %lld exceeds the limit of %llu voxels", (long long)r0, (long long)r1, (long long)r2, (unsigned long long)MURK_FIELD_MAX_VOXELS);
         return NULL;
     }
     int res[3] = {(int)r0, (int)r1, (int)r2}, org[3] = {bmin.x, bmin.y, bmin.z};
@@ -637,12 +616,12 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     lo = murk_v3(l[0], l[1], l[2]);
     hi = murk_v3(h[0], h[1], h[2]);
     if (!box_ok(lo, hi)) {
-        seterr(err, errlen, "%s: the grid's world box is not representable in float", path);
+        murk_err_file(err, errlen, path, "the grid's world box is not representable in float");
         return NULL;
     }
     float *data = malloc((size_t)n * sizeof *data);
     if (!data) {
-        seterr(err, errlen, "%s: out of memory for %llu voxels", path, (unsigned long long)n);
+        murk_err_file(err, errlen, path, "out of memory for %llu voxels", (unsigned long long)n);
         return NULL;
     }
     pnanovdb_readaccessor_t acc;
@@ -662,7 +641,7 @@ static murk_field *nvdb_densify(const char *path, const unsigned char *g, uint64
     }
     murk_field *f = grid_new(res, lo, hi, data);
     if (!f)
-        seterr(err, errlen, "%s: out of memory", path);
+        murk_err_file(err, errlen, path, "out of memory");
     return f;
 }
 #endif
@@ -682,7 +661,7 @@ murk_field *murk_field_nvdb_load(const char *path, char *err, size_t errlen)
     uint64_t padded = (len + 7) / 8 * 8;
     unsigned char *g = calloc(1, (size_t)padded);
     if (!g) {
-        seterr(err, errlen, "%s: out of memory", path);
+        murk_err_file(err, errlen, path, "out of memory");
         free(b);
         return NULL;
     }
@@ -693,7 +672,7 @@ murk_field *murk_field_nvdb_load(const char *path, char *err, size_t errlen)
     return f;
 #else
     free(b);
-    seterr(err, errlen, "%s: murk was built without NanoVDB support (nanovdb/PNanoVDB.h)", path);
+    murk_err_file(err, errlen, path, "murk was built without NanoVDB support (nanovdb/PNanoVDB.h)");
     return NULL;
 #endif
 }

@@ -1,6 +1,7 @@
 /* accel.c — the Embree 3 scene: triangle geometry for quads, boxes and meshes; Embree's analytic
  * point-spheres for spheres. Geometry ids equal shape indices. */
 #include "scene.h"
+#include "error.h"
 #include "util.h"
 
 #include <stdio.h>
@@ -16,7 +17,7 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
 {
     s->device = rtcNewDevice(NULL);
     if (!s->device) {
-        snprintf(err, errlen, "%s: cannot create an Embree device (error %d)", s->doc.file, (int)rtcGetDeviceError(NULL));
+        murk_err_file(err, errlen, s->doc.file, "cannot create an Embree device (error %d)", (int)rtcGetDeviceError(NULL));
         return -1;
     }
     rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
@@ -39,7 +40,7 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
                                                    sh->ntris);
             if (!v || !ix) {
                 rtcReleaseGeometry(g);
-                snprintf(err, errlen, "%s: Embree could not allocate geometry for shape %zu", s->doc.file, i);
+                murk_err_file(err, errlen, s->doc.file, "Embree could not allocate geometry for shape %zu", i);
                 return -1;
             }
             memcpy(v, sh->pos, 3u * sh->nverts * sizeof(float));
@@ -49,13 +50,13 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
         unsigned id = rtcAttachGeometry(s->rtc, g);
         rtcReleaseGeometry(g);
         if (id != i) {
-            snprintf(err, errlen, "%s: internal error: Embree geometry id %u for shape %zu", s->doc.file, id, i);
+            murk_err_file(err, errlen, s->doc.file, "internal error: Embree geometry id %u for shape %zu", id, i);
             return -1;
         }
     }
     rtcCommitScene(s->rtc);
     if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
-        snprintf(err, errlen, "%s: Embree failed to build the scene", s->doc.file);
+        murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
         return -1;
     }
     return 0;

@@ -18,6 +18,7 @@
  * "C" locale (switched for this thread only), which is correctly rounded too: both give the same
  * bits whatever locale the application has set. */
 #include "obj.h"
+#include "error.h"
 
 #include <errno.h>
 #include <locale.h>
@@ -27,14 +28,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/types.h>
-
-#ifndef MURK_PRINTF /* as in murk/plugin.h */
-#if defined(__GNUC__) || defined(__clang__)
-#define MURK_PRINTF(a, b) __attribute__((format(printf, a, b)))
-#else
-#define MURK_PRINTF(a, b)
-#endif
-#endif
 
 #define NO_INDEX UINT32_MAX
 /* Largest count of any element: indices must fit in uint32_t with NO_INDEX to spare. */
@@ -61,36 +54,20 @@ typedef struct objparse {
     locale_t c_locale;          /* for strtof, created on first use; (locale_t)0 if none */
 } objparse;
 
-MURK_PRINTF(3, 4)
-static int fail(char *err, size_t errlen, const char *fmt, ...)
-{
-    if (err && errlen > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
-
 /* "path:LINE:COL: message" with COL the column of at. */
 MURK_PRINTF(3, 4)
 static int fail_at(objparse *o, const char *at, const char *fmt, ...)
 {
-    if (o->err && o->errlen > 0) {
-        char msg[256];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(msg, sizeof msg, fmt, ap);
-        va_end(ap);
-        snprintf(o->err, o->errlen, "%s:%zu:%zu: %s", o->path, o->lineno, (size_t)(at - o->line) + 1, msg);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    murk_verr_at(o->err, o->errlen, o->path, (long)o->lineno, (long)(at - o->line) + 1, fmt, ap);
+    va_end(ap);
     return -1;
 }
 
 static int oom(objparse *o)
 {
-    return fail(o->err, o->errlen, "%s: out of memory", o->path);
+    return murk_err_file(o->err, o->errlen, o->path, "out of memory");
 }
 
 /* Makes room for need elements of size elem in p (capacity *cap); returns the (possibly moved)
@@ -260,7 +237,7 @@ static int parse_floats(objparse *o, const char *kw, const char *name, const cha
 static int push_floats(objparse *o, float **arr, size_t *n, size_t *cap, const float *vals, size_t count)
 {
     if (*n >= MAX_COUNT)
-        return fail(o->err, o->errlen, "%s:%zu:1: too many vertex attributes", o->path, o->lineno);
+        return murk_err_at(o->err, o->errlen, o->path, (long)o->lineno, 1, "too many vertex attributes");
     float *a = grow(*arr, cap, (*n + 1) * count, sizeof(float));
     if (!a)
         return oom(o);
@@ -316,7 +293,7 @@ static int unify(objparse *o, vkey k, uint32_t *out)
         }
     }
     if (o->nkeys >= MAX_COUNT)
-        return fail(o->err, o->errlen, "%s:%zu:1: too many distinct vertices", o->path, o->lineno);
+        return murk_err_at(o->err, o->errlen, o->path, (long)o->lineno, 1, "too many distinct vertices");
     vkey *keys = grow(o->keys, &o->capkeys, o->nkeys + 1, sizeof *keys);
     if (!keys)
         return oom(o);
@@ -491,13 +468,13 @@ static void parse_free(objparse *o)
 int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
 {
     if (!mesh)
-        return fail(err, errlen, "%s: no mesh to load into", path ? path : "(null)");
+        return murk_err_file(err, errlen, path ? path : "(null)", "no mesh to load into");
     memset(mesh, 0, sizeof *mesh);
     if (!path)
-        return fail(err, errlen, "(null): no path");
+        return murk_err_file(err, errlen, "(null)", "no path");
     FILE *f = fopen(path, "rb");
     if (!f)
-        return fail(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
 
     objparse o;
     memset(&o, 0, sizeof o);
@@ -513,7 +490,7 @@ int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
         if (n < 0) {
             if (ferror(f) || !feof(f)) {
                 int e = errno ? errno : EIO;
-                rc = e == ENOMEM ? oom(&o) : fail(err, errlen, "%s: read error: %s", path, strerror(e));
+                rc = e == ENOMEM ? oom(&o) : murk_err_file(err, errlen, path, "read error: %s", strerror(e));
             }
             break;
         }
@@ -526,7 +503,7 @@ int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
     free(line);
     fclose(f);
     if (rc == 0 && o.nidx == 0)
-        rc = fail(err, errlen, "%s: no faces", path);
+        rc = murk_err_file(err, errlen, path, "no faces");
     if (rc == 0 && build_mesh(&o, mesh) != 0)
         rc = -1;
     parse_free(&o);

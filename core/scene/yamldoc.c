@@ -1,5 +1,6 @@
 /* yamldoc.c — libyaml events to a located tree; --set overrides. */
 #include "yamldoc.h"
+#include "error.h"
 #include "util.h"
 
 #include <errno.h>
@@ -65,19 +66,11 @@ murk_ynode *murk_ymap_get(const murk_ynode *map, const char *key)
     return NULL;
 }
 
-static int verr(char *err, size_t errlen, const char *file, int line, int col, const char *fmt, va_list ap)
-{
-    int k = snprintf(err, errlen, "%s:%d:%d: ", file, line, col);
-    if (k >= 0 && (size_t)k < errlen)
-        vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
-    return -1;
-}
-
 int murk_yerr(char *err, size_t errlen, const murk_ynode *n, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    verr(err, errlen, n->file, n->line, n->col, fmt, ap);
+    murk_verr_at(err, errlen, n->file, n->line, n->col, fmt, ap);
     va_end(ap);
     return -1;
 }
@@ -86,7 +79,8 @@ int murk_yerr_key(char *err, size_t errlen, const murk_ynode *map, size_t i, con
 {
     va_list ap;
     va_start(ap, fmt);
-    verr(err, errlen, map->key_file ? map->key_file[i] : map->file, map->key_line[i], map->key_col[i], fmt, ap);
+    murk_verr_at(err, errlen, map->key_file ? map->key_file[i] : map->file, map->key_line[i], map->key_col[i], fmt,
+                 ap);
     va_end(ap);
     return -1;
 }
@@ -124,9 +118,9 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
                 tab = 1;
             }
             if (p->context && !tab)
-                snprintf(err, errlen, "%s:%d:%d: %s %s", file, line, col, prob, p->context);
+                murk_err_at(err, errlen, file, line, col, "%s %s", prob, p->context);
             else
-                snprintf(err, errlen, "%s:%d:%d: %s", file, line, col, prob);
+                murk_err_at(err, errlen, file, line, col, "%s", prob);
             rc = -1;
             break;
         }
@@ -139,13 +133,13 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
             break;
         case YAML_DOCUMENT_START_EVENT:
             if (++docs > 1) {
-                snprintf(err, errlen, "%s:%d:%d: a scene file holds one YAML document", file, line, col);
+                murk_err_at(err, errlen, file, line, col, "a scene file holds one YAML document");
                 rc = -1;
                 done = 1;
             }
             break;
         case YAML_ALIAS_EVENT:
-            snprintf(err, errlen, "%s:%d:%d: YAML aliases are not supported in scenes", file, line, col);
+            murk_err_at(err, errlen, file, line, col, "YAML aliases are not supported in scenes");
             rc = -1;
             done = 1;
             break;
@@ -187,13 +181,13 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
                 if (parent->kind == MURK_Y_MAP && !pending_key[depth - 1]) {
                     /* this node is a key */
                     if (container) {
-                        snprintf(err, errlen, "%s:%d:%d: a map key must be a plain name", file, line, col);
+                        murk_err_at(err, errlen, file, line, col, "a map key must be a plain name");
                         murk_ynode_free(node);
                         rc = -1;
                         done = 1;
                     } else {
                         if (murk_ymap_get(parent, node->str)) {
-                            snprintf(err, errlen, "%s:%d:%d: duplicate key '%s'", file, line, col, node->str);
+                            murk_err_at(err, errlen, file, line, col, "duplicate key '%s'", node->str);
                             murk_ynode_free(node);
                             rc = -1;
                             done = 1;
@@ -207,7 +201,7 @@ static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t text
                     }
                 } else if (container) {
                     if (depth >= MAX_DEPTH) {
-                        snprintf(err, errlen, "%s:%d:%d: nesting deeper than %d levels", file, line, col, MAX_DEPTH);
+                        murk_err_at(err, errlen, file, line, col, "nesting deeper than %d levels", MAX_DEPTH);
                         murk_ynode_free(node);
                         rc = -1;
                         done = 1;
@@ -248,7 +242,7 @@ static int load(murk_ydoc *doc, const unsigned char *text, size_t len, const cha
     doc->file = murk_strdup(name);
     yaml_parser_t p;
     if (!yaml_parser_initialize(&p)) {
-        snprintf(err, errlen, "%s: cannot initialise the YAML parser", name);
+        murk_err_file(err, errlen, name, "cannot initialise the YAML parser");
         return -1;
     }
     yaml_parser_set_input_string(&p, text, len);
@@ -271,7 +265,7 @@ int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errl
     memset(doc, 0, sizeof *doc);
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
         return -1;
     }
     size_t cap = 1 << 16, n = 0;
@@ -284,7 +278,7 @@ int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errl
         if (cap >= ((size_t)64 << 20)) {
             fclose(f);
             free(buf);
-            snprintf(err, errlen, "%s: scene file larger than 64 MiB", path);
+            murk_err_file(err, errlen, path, "scene file larger than 64 MiB");
             return -1;
         }
         buf = murk_xrealloc(buf, cap *= 2);
@@ -293,12 +287,12 @@ int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errl
     fclose(f);
     if (bad) {
         free(buf);
-        snprintf(err, errlen, "%s: cannot read: %s", path, strerror(saved));
+        murk_err_file(err, errlen, path, "cannot read: %s", strerror(saved));
         return -1;
     }
     if (memchr(buf, 0, n)) {
         free(buf);
-        snprintf(err, errlen, "%s:1:1: not a text file (contains NUL bytes)", path);
+        murk_err_at(err, errlen, path, 1, 1, "not a text file (contains NUL bytes)");
         return -1;
     }
     int rc = load(doc, buf, n, path, err, errlen);
@@ -341,7 +335,7 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
     static const char *const SETFILE = "--set";
     const char *eq = strchr(assignment, '=');
     if (!eq || eq == assignment) {
-        snprintf(err, errlen, "--set:1:1: expected KEY.PATH=VALUE, got '%s'", assignment);
+        murk_err_at(err, errlen, SETFILE, 1, 1, "expected KEY.PATH=VALUE, got '%s'", assignment);
         return -1;
     }
     int value_col = (int)(eq - assignment) + 2;
@@ -352,7 +346,7 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
         int l = 1, c = 1;
         if (sscanf(verrbuf, "--set:%d:%d:", &l, &c) == 2) {
             const char *msg = strchr(strchr(strchr(verrbuf, ':') + 1, ':') + 1, ':') + 1;
-            snprintf(err, errlen, "--set:1:%d:%s", c + value_col - 1, msg);
+            murk_err_at(err, errlen, SETFILE, 1, c + value_col - 1, "%s", msg + (*msg == ' '));
         } else {
             snprintf(err, errlen, "%s", verrbuf);
         }
@@ -382,13 +376,13 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
         if (len == 0) {
             free(key);
             murk_ynode_free(value);
-            snprintf(err, errlen, "--set:1:%d: empty key in '%.*s'", col, (int)(eq - assignment), assignment);
+            murk_err_at(err, errlen, SETFILE, 1, col, "empty key in '%.*s'", (int)(eq - assignment), assignment);
             return -1;
         }
         murk_ynode **slot = NULL;
         if (cur->kind == MURK_Y_SEQ) {
             if (!is_index(key) || strtoul(key, NULL, 10) >= cur->n) {
-                snprintf(err, errlen, "--set:1:%d: '%s' is not an index of this list (it has %zu items)", col, key,
+                murk_err_at(err, errlen, SETFILE, 1, col, "'%s' is not an index of this list (it has %zu items)", key,
                          cur->n);
                 free(key);
                 murk_ynode_free(value);
@@ -408,7 +402,7 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
                 free(key);
             }
         } else {
-            snprintf(err, errlen, "--set:1:%d: cannot descend into a scalar at '%s'", col, key);
+            murk_err_at(err, errlen, SETFILE, 1, col, "cannot descend into a scalar at '%s'", key);
             free(key);
             murk_ynode_free(value);
             return -1;
