@@ -99,12 +99,14 @@ void murk_registry_free(murk_registry *r)
     memset(r, 0, sizeof *r);
 }
 
+/* The ABI 1.0 size of a kind's vtable: plugins built against 1.0 headers have exactly this, later
+ * minors more (methods are appended; the host checks MURK_HAS before calling one of those). */
 static size_t vtable_min_size(int kind)
 {
     switch (kind) {
-    case MURK_KIND_MATERIAL: return sizeof(murk_material_vt);
-    case MURK_KIND_MEDIUM: return sizeof(murk_medium_vt);
-    case MURK_KIND_INTEGRATOR: return sizeof(murk_integrator_vt);
+    case MURK_KIND_MATERIAL: return MURK_MATERIAL_VT_SIZE_1_0;
+    case MURK_KIND_MEDIUM: return MURK_MEDIUM_VT_SIZE_1_0;
+    case MURK_KIND_INTEGRATOR: return MURK_INTEGRATOR_VT_SIZE_1_0;
     default: return 0;
     }
 }
@@ -253,9 +255,9 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
         blen -= 3;
     if (!d)
         rc = fail(err, errlen, path, "%s() returned no descriptor", MURK_PLUGIN_ENTRY_SYMBOL);
-    else if (d->struct_size != sizeof(murk_plugin_desc))
-        rc = fail(err, errlen, path, "descriptor struct_size is %u bytes, expected %zu for ABI %u.%u", d->struct_size,
-                  sizeof(murk_plugin_desc), abicopy.major, abicopy.minor);
+    else if (d->struct_size < MURK_PLUGIN_DESC_SIZE_1_0)
+        rc = fail(err, errlen, path, "descriptor struct_size is %u bytes, expected at least %zu for ABI %u.%u",
+                  d->struct_size, (size_t)MURK_PLUGIN_DESC_SIZE_1_0, abicopy.major, abicopy.minor);
     else if (d->kind < MURK_KIND_MATERIAL || d->kind > MURK_KIND_INTEGRATOR)
         rc = fail(err, errlen, path, "unknown plugin kind %u", d->kind);
     else if (!d->name || strlen(d->name) != blen || strncmp(d->name, base, blen) != 0)
@@ -266,9 +268,13 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
                   murk_kind_name((int)d->kind), article(kind), murk_kind_name(kind));
     else if (!d->vtable)
         rc = fail(err, errlen, path, "descriptor has no vtable");
-    else if (*(const uint32_t *)d->vtable < vtable_min_size((int)d->kind))
+    else if (((const murk_vt_head *)d->vtable)->kind != d->kind)
+        rc = fail(err, errlen, path, "declares %s %s plugin but its vtable is marked kind %u (%s): use the "
+                  "MURK_<KIND>_PLUGIN macro of that kind's header", article((int)d->kind), murk_kind_name((int)d->kind),
+                  ((const murk_vt_head *)d->vtable)->kind, murk_kind_name((int)((const murk_vt_head *)d->vtable)->kind));
+    else if (((const murk_vt_head *)d->vtable)->size < vtable_min_size((int)d->kind))
         rc = fail(err, errlen, path, "%s vtable is %u bytes, expected at least %zu", murk_kind_name((int)d->kind),
-                  *(const uint32_t *)d->vtable, vtable_min_size((int)d->kind));
+                  ((const murk_vt_head *)d->vtable)->size, vtable_min_size((int)d->kind));
     else
         rc = check_params(d, path, err, errlen);
     if (rc == 0 && !d->description)
@@ -292,6 +298,37 @@ static int valid_name(const char *name)
         if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_' || *c == '-'))
             return 0;
     return 1;
+}
+
+/* A plugin found in search folder `used` hides files of the same name later on the path (a
+ * MURK_PLUGIN_PATH entry can replace a built-in): say so once per name, naming both files. */
+static void warn_shadowed(const murk_registry *r, size_t used, const char *name, const char *path)
+{
+    for (size_t j = used + 1; j < r->ndirs; j++) {
+        char other[4096];
+        snprintf(other, sizeof other, "%s/%s.so", r->dirs[j], name);
+        if (access(other, F_OK) == 0) {
+            murk_log(MURK_LOG_WARN, "plugin '%s': %s hides %s (it comes first on the plugin search path)", name,
+                     path, other);
+            return;
+        }
+    }
+}
+
+size_t murk_registry_describe(const murk_registry *r, char *buf, size_t len)
+{
+    size_t k = 0;
+    if (len)
+        buf[0] = 0;
+    for (size_t i = 0; i < r->nloaded && k < len; i++) {
+        const murk_plugin *p = r->loaded[i];
+        int n = snprintf(buf + k, len - k, "%s%s=%s (ABI %u.%u)", i ? "; " : "", p->desc->name, p->path, p->abi.major,
+                         p->abi.minor);
+        if (n < 0)
+            break;
+        k += (size_t)n;
+    }
+    return k;
 }
 
 const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *name, char *err, size_t errlen)
@@ -327,6 +364,7 @@ const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *na
         }
         r->loaded = murk_xrealloc(r->loaded, (r->nloaded + 1) * sizeof *r->loaded);
         r->loaded[r->nloaded++] = p;
+        warn_shadowed(r, i, name, p->path);
         return p;
     }
     /* nothing by that name: suggest the closest plugin file on the path */

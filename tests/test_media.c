@@ -189,11 +189,11 @@ static void run_tracker(const murk_medium *m, const murk_ray *ray, long n, uint6
         murk_rgb T = m->vt->transmittance(m->self, ray, &ctx, &rng);
         ctx.hero = (int)(murk_rng_float(&rng) * 3.0f);
         murk_medium_event ev;
-        int r = m->vt->sample(m->self, ray, &ctx, &rng, &ev);
-        double mp = ((double)ev.pdf.c[0] + ev.pdf.c[1] + ev.pdf.c[2]) / 3.0;
-        if (!murk_rgb_finite(T) || !murk_rgb_finite(ev.weight) || !murk_rgb_finite(ev.pdf) || !isfinite(ev.t))
+        m->vt->sample(m->self, ray, &ctx, &rng, &ev);
+        double mp = ((double)ev.pdf_ratio.c[0] + ev.pdf_ratio.c[1] + ev.pdf_ratio.c[2]) / 3.0;
+        if (!murk_rgb_finite(T) || !murk_rgb_finite(ev.weight) || !murk_rgb_finite(ev.pdf_ratio) || !isfinite(ev.t))
             st->nonfinite++;
-        if (r != ev.scattered || (ev.scattered && !(ev.t >= ray->tmin && ev.t <= ray->tmax)))
+        if ((ev.scattered != 0 && ev.scattered != 1) || (ev.scattered && !(ev.t >= ray->tmin && ev.t <= ray->tmax)))
             st->bad_t++;
         int b = ev.scattered ? (int)(((double)ev.t - ray->tmin) / width) : -1;
         if (b >= NBINS)

@@ -302,12 +302,6 @@ static void test_slab(void **state)
 #define INV_RES 32
 #define INV_BLOCK 4
 
-/* A config rendered INV_SEEDS times with different seeds: per-pixel mean and the variance of that mean
- * (the sample variance over the seeds / INV_SEEDS), per channel and for the channel average. */
-typedef struct multi {
-    double mean[INV_RES * INV_RES][4], var[INV_RES * INV_RES][4];
-} multi;
-
 /* Thin (optical depth ~0.5 across), fairly absorbing cloud lit by a small lamp, black background:
  * nearly single scattering, so the image responds to the density almost linearly (a 3% denser
  * medium is ~2% brighter) and a density bias cannot hide. */
@@ -329,92 +323,17 @@ static const char *inv_scene(const char *keys)
                       INV_RES, INV_RES, INV_SPP, keys);
 }
 
-static void render_multi(const char *keys, multi *m)
+/* A config rendered INV_SEEDS times with different seeds (per-pixel means and their variances). */
+static void render_multi(const char *keys, img_stack *m)
 {
-    memset(m, 0, sizeof *m);
-    const char *scene = inv_scene(keys);
-    static double s[INV_RES * INV_RES][4], s2[INV_RES * INV_RES][4];
-    memset(s, 0, sizeof s);
-    memset(s2, 0, sizeof s2);
-    for (int k = 0; k < INV_SEEDS; k++) {
-        char seed[64];
-        snprintf(seed, sizeof seed, "render.seed=%d", 100 + k);
-        murk_image img;
-        render_img(scene, out_path("inv.exr"), &img, "--set", seed, NULL, NULL);
-        assert_int_equal(img.w, INV_RES);
-        assert_int_equal(img.h, INV_RES);
-        for (int p = 0; p < INV_RES * INV_RES; p++) {
-            double v[4];
-            v[3] = 0;
-            for (int c = 0; c < 3; c++) {
-                v[c] = img.rgb[3 * p + c];
-                v[3] += v[c] / 3.0;
-            }
-            for (int c = 0; c < 4; c++) {
-                s[p][c] += v[c];
-                s2[p][c] += v[c] * v[c];
-            }
-        }
-        murk_image_free(&img);
-    }
-    for (int p = 0; p < INV_RES * INV_RES; p++)
-        for (int c = 0; c < 4; c++) {
-            double mu = s[p][c] / INV_SEEDS;
-            m->mean[p][c] = mu;
-            m->var[p][c] = fmax(0.0, (s2[p][c] - INV_SEEDS * mu * mu) / (INV_SEEDS - 1)) / INV_SEEDS;
-        }
+    img_stack_free(m);
+    img_stack_render(m, inv_scene(keys), "inv.exr", INV_SEEDS, 100, NULL);
 }
 
-/* Block-wise z-test of a against the reference r: per 4x4 block and channel, the difference of block
- * means over the standard error from both renders' per-pixel variances. Returns 1 if they agree: no
- * block differs by more than 4.5 sigma in any channel, and the mean over blocks of the channel-average
- * z-score is within 4 / sqrt(nblocks) of 0 (the blocks are independent, each z ~ N(0,1), so the mean
- * has standard deviation 1 / sqrt(nblocks)). */
-static int blocks_agree(const char *label, const multi *a, const multi *r)
+/* Block-wise z-test against the reference (see img_stack_agree): no 4x4 block beyond 4.5 sigma. */
+static int blocks_agree(const char *label, const img_stack *a, const img_stack *r)
 {
-    const int nb = INV_RES / INV_BLOCK;
-    int nblocks = 0; /* blocks with signal (all-black blocks have no variance and carry no information) */
-    double zmax = 0.0, zsum = 0.0, rel = 0.0, sum_ref = 0.0;
-    int zmax_at = -1;
-    for (int by = 0; by < nb; by++)
-        for (int bx = 0; bx < nb; bx++)
-            for (int c = 0; c < 4; c++) {
-                double ma = 0, mr = 0, va = 0, vr = 0;
-                for (int y = 0; y < INV_BLOCK; y++)
-                    for (int x = 0; x < INV_BLOCK; x++) {
-                        int p = (by * INV_BLOCK + y) * INV_RES + bx * INV_BLOCK + x;
-                        ma += a->mean[p][c];
-                        mr += r->mean[p][c];
-                        va += a->var[p][c];
-                        vr += r->var[p][c];
-                    }
-                const double n = INV_BLOCK * INV_BLOCK;
-                if (!(va + vr > 0.0)) {
-                    if (ma != mr && c < 3) /* no noise but a difference: certainly not the same image */
-                        zmax = INFINITY, zmax_at = (by * nb + bx) * 3 + c;
-                    continue;
-                }
-                double z = (ma - mr) / n / sqrt((va + vr) / (n * n));
-                if (c == 3) {
-                    nblocks++;
-                    zsum += z;
-                    rel += sqrt(vr) / n; /* se of the reference's block mean */
-                    sum_ref += mr / n;
-                } else if (fabs(z) > zmax) {
-                    zmax = fabs(z);
-                    zmax_at = (by * nb + bx) * 3 + c;
-                }
-            }
-    if (nblocks < 16) {
-        printf("  %-34s only %d blocks with signal  <-- FAIL\n", label, nblocks);
-        return 0;
-    }
-    double zmean = zsum / nblocks, bound = 4.0 / sqrt((double)nblocks);
-    int ok = zmax <= 4.5 && fabs(zmean) <= bound;
-    printf("  %-40s max |z| %.2f (block %d, channel %d), mean z %+.3f over %d blocks (bound %.3f), block se %.2f%%: "
-           "%s\n",
-           label, zmax, zmax_at / 3, zmax_at % 3, zmean, nblocks, bound, 100.0 * rel / sum_ref, ok ? "agree" : "DIFFER");
-    return ok;
+    return img_stack_agree(label, a, r, INV_BLOCK, 4.5);
 }
 
 static void test_invariance(void **state)
@@ -441,15 +360,13 @@ static void test_invariance(void **state)
 #endif
     };
     /* (decomposition control 0 makes the same random decisions as delta: that comparison is exact) */
-    multi *ref = malloc(sizeof *ref), *m = malloc(sizeof *m);
-    assert_non_null(ref);
-    assert_non_null(m);
-    render_multi("type: delta", ref);
+    img_stack ref = {0}, m = {0};
+    render_multi("type: delta", &ref);
     printf("invariance against delta tracking (%dx%d, %d seeds x %d spp, %d blocks of %dx%d):\n", INV_RES, INV_RES,
            INV_SEEDS, INV_SPP, (INV_RES / INV_BLOCK) * (INV_RES / INV_BLOCK), INV_BLOCK, INV_BLOCK);
     for (size_t v = 0; v < sizeof variants / sizeof variants[0]; v++) {
-        render_multi(variants[v][1], m);
-        if (!blocks_agree(variants[v][0], m, ref))
+        render_multi(variants[v][1], &m);
+        if (!blocks_agree(variants[v][0], &m, &ref))
             nfail++;
     }
     /* the negative control: a 3% denser medium must be told apart (the reference report's
@@ -459,14 +376,14 @@ static void test_invariance(void **state)
         {"decomposition 0.1, x " INV_DENSER " (must DIFFER)", "type: decomposition, control: 0.1, scale: " INV_DENSER},
     };
     for (int v = 0; v < 2; v++) {
-        render_multi(denser[v][1], m);
-        if (blocks_agree(denser[v][0], m, ref)) {
+        render_multi(denser[v][1], &m);
+        if (blocks_agree(denser[v][0], &m, &ref)) {
             printf("  the comparison cannot see a density change of x %s  <-- FAIL\n", INV_DENSER);
             nfail++;
         }
     }
-    free(ref);
-    free(m);
+    img_stack_free(&ref);
+    img_stack_free(&m);
     printf("invariance: %.1f s\n", now() - t0);
     assert_int_equal(nfail, 0);
 }

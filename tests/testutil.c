@@ -1,5 +1,6 @@
 /* testutil.c — see testutil.h */
 #include "testutil.h"
+#include "image.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -57,14 +58,24 @@ const char *write_tmp(const char *name, const char *text)
 
 int run_murk(char **out, const char *arg0, ...)
 {
-    const char *argv[64];
-    int argc = 0;
-    argv[argc++] = env_or("MURK_EXE", "build/core/murk");
+    const char *args[64];
+    int n = 0;
     va_list ap;
     va_start(ap, arg0);
-    for (const char *a = arg0; a && argc < 63; a = va_arg(ap, const char *))
-        argv[argc++] = a;
+    for (const char *a = arg0; a && n < 63; a = va_arg(ap, const char *))
+        args[n++] = a;
     va_end(ap);
+    args[n] = NULL;
+    return run_murk_argv(out, args);
+}
+
+int run_murk_argv(char **out, const char *const *args)
+{
+    const char *argv[96];
+    int argc = 0;
+    argv[argc++] = env_or("MURK_EXE", "build/core/murk");
+    for (; *args && argc < 95; args++)
+        argv[argc++] = *args;
     argv[argc] = NULL;
 
     char logpath[512];
@@ -188,4 +199,119 @@ double chi2_test(const double *observed, const double *expected, int nbins, doub
     if (dof < 1)
         return 1.0;
     return gamma_q(dof / 2.0, chsq / 2.0);
+}
+
+/* ---- image stacks -------------------------------------------------------------------------- */
+
+void img_stack_render(img_stack *st, const char *scene, const char *out, int nseeds, int seed0,
+                      const char *const *extra)
+{
+    char path[512], seed[64];
+    snprintf(path, sizeof path, "%s/%s", tmp_dir(), out);
+    memset(st, 0, sizeof *st);
+    st->n = nseeds;
+    for (int k = 0; k < nseeds; k++) {
+        snprintf(seed, sizeof seed, "render.seed=%d", seed0 + k);
+        const char *args[64] = {"render", scene, "-o", path, "--threads", "2", "--quiet", "--set", seed};
+        int na = 9;
+        for (; extra && extra[na - 9] && na < 63; na++)
+            args[na] = extra[na - 9];
+        args[na] = NULL;
+        char *log = NULL;
+        int rc = run_murk_argv(&log, args);
+        if (rc != 0)
+            fail_msg("murk render %s failed (%d):\n%s", scene, rc, log);
+        free(log);
+        murk_image img;
+        char err[512];
+        if (murk_exr_read(path, &img, err, sizeof err) != 0)
+            fail_msg("%s", err);
+        const char *nf = murk_image_meta(&img, "murk:nonfinite_samples");
+        if (!nf || strcmp(nf, "0") != 0)
+            fail_msg("%s: %s NaN/inf samples", scene, nf ? nf : "(no count)");
+        size_t np = (size_t)img.w * (size_t)img.h;
+        if (k == 0) {
+            st->w = img.w;
+            st->h = img.h;
+            st->mean = calloc(np, sizeof *st->mean);
+            st->var = calloc(np, sizeof *st->var); /* sums of squares until the end */
+            assert_non_null(st->mean);
+            assert_non_null(st->var);
+        }
+        assert_int_equal(img.w, st->w);
+        assert_int_equal(img.h, st->h);
+        for (size_t p = 0; p < np; p++) {
+            double v[4] = {img.rgb[3 * p], img.rgb[3 * p + 1], img.rgb[3 * p + 2], 0.0};
+            v[3] = (v[0] + v[1] + v[2]) / 3.0;
+            for (int c = 0; c < 4; c++) {
+                st->mean[p][c] += v[c];
+                st->var[p][c] += v[c] * v[c];
+            }
+        }
+        murk_image_free(&img);
+    }
+    size_t np = (size_t)st->w * (size_t)st->h;
+    for (size_t p = 0; p < np; p++)
+        for (int c = 0; c < 4; c++) {
+            double mu = st->mean[p][c] / nseeds;
+            st->mean[p][c] = mu;
+            st->var[p][c] = fmax(0.0, (st->var[p][c] - nseeds * mu * mu) / (nseeds - 1)) / nseeds;
+        }
+}
+
+void img_stack_free(img_stack *st)
+{
+    free(st->mean);
+    free(st->var);
+    memset(st, 0, sizeof *st);
+}
+
+int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, int block, double zlimit)
+{
+    assert_int_equal(a->w, r->w);
+    assert_int_equal(a->h, r->h);
+    const int nbx = r->w / block, nby = r->h / block;
+    int nblocks = 0; /* blocks with signal (all-black blocks have no variance and carry no information) */
+    double zmax = 0.0, zsum = 0.0, rel = 0.0, sum_ref = 0.0;
+    int zmax_x = -1, zmax_y = -1, zmax_c = -1;
+    for (int by = 0; by < nby; by++)
+        for (int bx = 0; bx < nbx; bx++)
+            for (int c = 0; c < 4; c++) {
+                double ma = 0, mr = 0, va = 0, vr = 0;
+                for (int y = 0; y < block; y++)
+                    for (int x = 0; x < block; x++) {
+                        size_t p = (size_t)(by * block + y) * (size_t)r->w + (size_t)(bx * block + x);
+                        ma += a->mean[p][c];
+                        mr += r->mean[p][c];
+                        va += a->var[p][c];
+                        vr += r->var[p][c];
+                    }
+                const double n = (double)block * block;
+                if (!(va + vr > 0.0)) {
+                    if (ma != mr && c < 3) { /* no noise but a difference: certainly not the same image */
+                        zmax = INFINITY;
+                        zmax_x = bx, zmax_y = by, zmax_c = c;
+                    }
+                    continue;
+                }
+                double z = (ma - mr) / sqrt(va + vr);
+                if (c == 3) {
+                    nblocks++;
+                    zsum += z;
+                    rel += sqrt(vr) / n; /* se of the reference's block mean */
+                    sum_ref += mr / n;
+                } else if (fabs(z) > zmax) {
+                    zmax = fabs(z);
+                    zmax_x = bx, zmax_y = by, zmax_c = c;
+                }
+            }
+    if (nblocks < 16) {
+        printf("  %-44s only %d blocks with signal  <-- FAIL\n", label, nblocks);
+        return 0;
+    }
+    double zmean = zsum / nblocks, bound = 4.0 / sqrt((double)nblocks);
+    int ok = zmax <= zlimit && fabs(zmean) <= bound;
+    printf("  %-44s max |z| %.2f (block %d,%d ch %d), mean z %+.3f over %d blocks (bound %.3f), block se %.2f%%: %s\n",
+           label, zmax, zmax_x, zmax_y, zmax_c, zmean, nblocks, bound, 100.0 * rel / sum_ref, ok ? "agree" : "DIFFER");
+    return ok;
 }

@@ -19,6 +19,31 @@ const char *tmp_dir(void);
 /* Writes text to tmp_dir()/name and returns its path. */
 const char *write_tmp(const char *name, const char *text);
 
+/* The same with the arguments in a NULL-terminated array. */
+int run_murk_argv(char **out, const char *const *args);
+
+/* A scene rendered with several seeds: per pixel and channel (r, g, b, and their average in channel
+ * 3) the mean over the renders and the variance of that mean (sample variance over the seeds / n). */
+typedef struct img_stack {
+    int w, h, n;
+    double (*mean)[4], (*var)[4];
+} img_stack;
+
+/* Renders scene `nseeds` times (--set render.seed=seed0+k, --threads 2, --quiet, plus the extra
+ * arguments, NULL-terminated, may be NULL) into tmp_dir()/out; fails the test if a render fails or
+ * drops a NaN/inf sample. */
+void img_stack_render(img_stack *st, const char *scene, const char *out, int nseeds, int seed0,
+                      const char *const *extra);
+void img_stack_free(img_stack *st);
+
+/* Block-wise z-test of a against the reference r: per block of block x block pixels and channel, the
+ * difference of block means over its standard error from both stacks' per-pixel variances. They agree
+ * when no block differs by more than zmax sigma in any channel and the mean over blocks of the
+ * channel-average z is within 4 / sqrt(nblocks) of 0 (independent blocks, each z ~ N(0, 1)). Prints
+ * one line (worst block, mean z, the reference's block standard error in percent) and returns 1 if
+ * they agree. Fewer than 16 blocks with signal is a failure (too little to judge). */
+int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, int block, double zmax);
+
 /* Pearson chi-square test of observed counts against expected counts, merging bins (in order of
  * increasing expectation) until each holds at least min_expected. Returns the p-value. */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out);

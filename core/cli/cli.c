@@ -158,7 +158,8 @@ static int cmd_render(int argc, char **argv)
     murk_render_result res;
     murk_render(s, &opts, &res);
 
-    char spp[32], seed[32], secs[32], nonfinite[32], setbuf[4096] = "";
+    char spp[32], seed[32], secs[32], nonfinite[32], setbuf[4096] = "", plugins[4096];
+    murk_registry_describe(&s->reg, plugins, sizeof plugins);
     snprintf(spp, sizeof spp, "%d", res.spp);
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
@@ -168,7 +169,7 @@ static int cmd_render(int argc, char **argv)
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
-        {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf},
+        {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
     };
     char *png = png_path_for(outbuf);
     int rc = 0;

@@ -231,7 +231,6 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     md->size = sizeof *md;
     md->sigma_a = murk_rgb1(0.0f);
     md->sigma_s = murk_rgb1(1.0f);
-    md->majorant_factor = 1.0f;
     double scale = 1.0, g = 0.0, mf = 1.0, mres = 16;
     const murk_ynode *k;
     if (((k = murk_ymap_get(m, "sigma_a")) && rgb(k, "sigma_a", 0, 1e8, &md->sigma_a, err, errlen)) ||
@@ -244,7 +243,6 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     md->sigma_a = murk_rgb_scale(md->sigma_a, (float)scale);
     md->sigma_s = murk_rgb_scale(md->sigma_s, (float)scale);
     md->g = (float)g;
-    md->majorant_factor = (float)mf;
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);
     nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
@@ -254,8 +252,6 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
         return murk_yerr(err, errlen, dn ? dn : m, "%s: cannot build the majorant grid (out of memory)", who);
     nm->density->factor = (float)mf;
     md->density = nm->density;
-    md->density_max = murk_field_max(nm->density->field);
-    md->density_min = murk_field_min(nm->density->field);
     md->name = nm->name = murk_strdup(name);
     if (mf < 1.0)
         murk_log(MURK_LOG_WARN,

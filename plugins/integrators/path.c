@@ -11,21 +11,16 @@
  * is taken with weight 1. The constant background is reached by BSDF sampling only (it is not a light
  * that NEE samples). Shadow rays pass through index-matched medium boundaries but stop at any surface
  * with a material. This integrator ignores media (use volpath or volpath_nee for them): it is the
- * shared tracer of volpath_common.h with media switched off. */
-#include <stdio.h>
+ * shared tracer of pathtracer.h (pathtracer.c) with media switched off. */
+#include "pathtracer.h"
 
-#include "volpath_common.h"
-
-static murk_rgb li(const void *self, const murk_scene *scene, const murk_ray *ray, murk_rng *rng)
+static int create(const murk_host *host, const murk_value *params, void **self, char *err, size_t errlen)
 {
-    return volpath_li_impl(self, scene, ray, rng, 1, 0);
+    return murk_pt_create(host, params, 1, 0, self, err, errlen);
 }
 
-static const murk_integrator_vt vt = {sizeof(murk_integrator_vt), volpath_create, volpath_destroy, li};
+static const murk_integrator_vt vt = {sizeof(murk_integrator_vt), MURK_KIND_INTEGRATOR, create, murk_pt_destroy,
+                                      murk_pt_li};
 
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_INTEGRATOR, "path",
-    "surface path tracing, NEE + BSDF sampling with MIS, Russian roulette", params, P_COUNT, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_INTEGRATOR_PLUGIN("path", "surface path tracing, NEE + BSDF sampling with MIS, Russian roulette",
+                       murk_pt_params, MURK_PT_NPARAMS, &vt)

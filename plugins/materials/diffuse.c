@@ -83,11 +83,8 @@ static int diffuse_sample(const void *self, const murk_hit *hit, murk_vec3 wo, c
 }
 
 static const murk_material_vt vt = {
-    sizeof(murk_material_vt), diffuse_create, diffuse_destroy, diffuse_eval, diffuse_pdf, diffuse_sample,
+    sizeof(murk_material_vt), MURK_KIND_MATERIAL, diffuse_create, diffuse_destroy, diffuse_eval, diffuse_pdf,
+    diffuse_sample,
 };
 
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MATERIAL, "diffuse", "Lambertian diffuse reflection", params, P_COUNT, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MATERIAL_PLUGIN("diffuse", "Lambertian diffuse reflection", params, P_COUNT, &vt)

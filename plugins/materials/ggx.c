@@ -517,15 +517,11 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
 }
 
 static const murk_material_vt vt = {
-    sizeof(murk_material_vt), ggx_create, ggx_destroy, ggx_eval, ggx_pdf, ggx_sample,
+    sizeof(murk_material_vt), MURK_KIND_MATERIAL, ggx_create, ggx_destroy, ggx_eval, ggx_pdf, ggx_sample,
 };
 
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MATERIAL, "ggx",
-    "Lambertian base under a GGX specular coat (energy-conserving, reciprocal)", params, P_COUNT, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MATERIAL_PLUGIN("ggx", "Lambertian base under a GGX specular coat (energy-conserving, reciprocal)", params,
+                     P_COUNT, &vt)
 
 #ifdef MURK_GGX_GENERATE_TABLES
 /* ---- Table generator (not part of the plugin) ----------------------------------------------------

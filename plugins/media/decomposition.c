@@ -34,7 +34,6 @@ static const murk_param params[P_COUNT] = {
 typedef struct decomposition {
     murk_tracker base;
     float smin, control;
-    int grey;
 } decomposition;
 
 static int decomposition_create(const murk_host *host, const murk_medium_data *data, const murk_value *p,
@@ -44,7 +43,6 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     if (!m)
         return -1;
     m->smin = murk_minf(m->base.sigma_t.c[0], murk_minf(m->base.sigma_t.c[1], m->base.sigma_t.c[2]));
-    m->grey = m->base.sigma_t.c[0] == m->base.sigma_t.c[1] && m->base.sigma_t.c[1] == m->base.sigma_t.c[2];
     m->control = (float)p[P_CONTROL].f[0];
     if (m->control > 1.0f)
         host->log(MURK_LOG_WARN,
@@ -54,8 +52,8 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     return 0;
 }
 
-static int decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                                murk_medium_event *ev)
+static void decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                                 murk_medium_event *ev)
 {
     const decomposition *m = self;
     const murk_host *h = m->base.host;
@@ -63,7 +61,7 @@ static int decomposition_sample(const void *self, const murk_ray *ray, const mur
     const murk_rgb st = m->base.sigma_t;
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
-        return 0;
+        return;
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin;
@@ -83,39 +81,34 @@ static int decomposition_sample(const void *self, const murk_ray *ray, const mur
                     ev->weight.c[k] *= st.c[k] > 0.0f ? d->sigma_s.c[k] / st.c[k] : 0.0f;
                 ev->scattered = 1;
                 ev->t = tc;
-                return 1;
+                return;
             }
             t = tr;
             float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
-            float a[3], amin = INFINITY, amax = -INFINITY, pr = 0.0f, pn = 0.0f;
+            float a[3], amin = INFINITY, amax = -INFINITY;
             for (int k = 0; k < 3; k++) { /* residual share of channel k */
                 a[k] = (dens * st.c[k] - rate_c) / mu_r;
                 amin = murk_minf(amin, a[k]);
                 amax = murk_maxf(amax, a[k]);
-                float hk = fabsf(ctx->beta.c[k] * ev->weight.c[k]);
-                pr += hk * fabsf(a[k]);
-                pn += hk * fabsf(1.0f - a[k]);
             }
             if (amin < 0.0f)
                 h->warn_once("medium '%s': decomposition control exceeds the local density (negative residual): "
                              "weighted residual collisions (unbiased, noisier)", d->name);
             if (amax > 1.0f)
-                h->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): decomposition "
-                             "tracking switches to weighted residual collisions (unbiased, noisier)", d->name);
-            float q = m->grey ? murk_real_prob(a[0], 1.0f - a[0]) : (pr + pn > 0.0f ? pr / (pr + pn) : 0.5f);
+                murk_warn_majorant(&m->base, "decomposition tracking switches to weighted residual collisions");
+            float q = murk_collision_prob(&m->base, a, ctx, ev->weight);
             if (murk_rng_float(rng) < q) {
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= st.c[k] > 0.0f ? a[k] / q * (d->sigma_s.c[k] / st.c[k]) : 0.0f;
                 ev->scattered = 1;
                 ev->t = t;
-                return 1;
+                return;
             }
-            if (!m->grey || amin < 0.0f || amax > 1.0f)
+            if (!m->base.grey || amin < 0.0f || amax > 1.0f)
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q);
         }
     }
-    return 0;
 }
 
 static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx,
@@ -126,12 +119,8 @@ static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ra
     return murk_ratio_tracking(m->base.host, m->base.d, ray, m->control, rng);
 }
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), decomposition_create, murk_tracker_free,
-                                  decomposition_sample, decomposition_transmittance};
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, decomposition_create,
+                                  murk_tracker_free, decomposition_sample, decomposition_transmittance};
 
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, "decomposition",
-    "decomposition tracking (Kutz et al. 2017): closed-form control + tracked residual", params, P_COUNT, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MEDIUM_PLUGIN("decomposition", "decomposition tracking (Kutz et al. 2017): closed-form control + tracked residual",
+                   params, P_COUNT, &vt)

@@ -21,8 +21,8 @@ static int naive_create(const murk_host *host, const murk_medium_data *data, con
     return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
 }
 
-static int naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                        murk_medium_event *ev)
+static void naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                         murk_medium_event *ev)
 {
     const murk_tracker *m = self;
     int hero = ctx->hero;
@@ -30,43 +30,30 @@ static int naive_sample(const void *self, const murk_ray *ray, const murk_path_c
     murk_event_init(ev, ray);
     ev->weight = murk_rgb1(0.0f); /* only the hero channel carries this path */
     ev->weight.c[hero] = 1.0f;
-    ev->pdf = ev->weight;
+    ev->pdf_ratio = ev->weight;
     if (!(st > 0.0f))
-        return 0;
+        return;
     murk_collisions c;
     murk_collisions_init(&c, m, ray, st); /* the hero channel's own majorant */
     float t, dens;
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a = dens * st / c.mu;
         if (a > 1.0f)
-            m->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): per-channel delta "
-                               "tracking uses weighted collisions (unbiased, noisier)", m->d->name);
+            murk_warn_majorant(m, "per-channel delta tracking uses weighted collisions");
         float q = murk_real_prob(a, 1.0f - a);
         if (murk_rng_float(rng) < q) {
             ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (c.mu * q);
             ev->scattered = 1;
             ev->t = t;
-            return 1;
+            return;
         }
         if (a > 1.0f)
             ev->weight.c[hero] *= (1.0f - a) / (1.0f - q);
     }
-    return 0;
 }
 
-static murk_rgb naive_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
-{
-    (void)ctx; /* every channel is estimated; only the hero's carries weight in the path */
-    const murk_tracker *m = self;
-    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
-}
+/* every channel's transmittance is estimated; only the hero's carries weight in the path */
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, naive_create, murk_tracker_free,
+                                  naive_sample, murk_tracker_transmittance};
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), naive_create, murk_tracker_free, naive_sample,
-                                  naive_transmittance};
-
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, "naive_spectral",
-    "per-channel delta tracking (one channel per path): the baseline", NULL, 0, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MEDIUM_PLUGIN("naive_spectral", "per-channel delta tracking (one channel per path): the baseline", NULL, 0, &vt)

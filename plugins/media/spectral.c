@@ -51,14 +51,14 @@ static float pick(int scheme, const float x[3], const float w[3])
     return (fabsf(w[0] * x[0]) + fabsf(w[1] * x[1]) + fabsf(w[2] * x[2])) / 3.0f;
 }
 
-static int spectral_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                           murk_medium_event *ev)
+static void spectral_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                            murk_medium_event *ev)
 {
     const spectral *m = self;
     const murk_medium_data *d = m->base.d;
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
-        return 0;
+        return;
     murk_collisions c;
     murk_collisions_init(&c, &m->base, ray, m->base.smax);
     float t, dens;
@@ -73,43 +73,29 @@ static int spectral_sample(const void *self, const murk_ray *ray, const murk_pat
             hist[k] = ctx->beta.c[k] * ev->weight.c[k];
         }
         if (neg)
-            m->base.host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral "
-                                    "tracking uses negative null weights (unbiased, noisier)", d->name);
+            murk_warn_majorant(&m->base, "spectral tracking uses negative null weights");
         float pa = pick(m->scheme, sa, hist), ps = pick(m->scheme, ss, hist), pn = pick(m->scheme, sn, hist);
         float sum = pa + ps + pn, u = murk_rng_float(rng) * sum;
         if (!(sum > 0.0f) || u < pa) { /* absorbed (or no weight left in any channel): the path ends */
             ev->weight = murk_rgb1(0.0f);
             ev->scattered = 1;
             ev->t = t;
-            return 1;
+            return;
         }
         if (u < pa + ps) {
             for (int k = 0; k < 3; k++)
                 ev->weight.c[k] *= ss[k] * sum / (c.mu * ps);
             ev->scattered = 1;
             ev->t = t;
-            return 1;
+            return;
         }
         for (int k = 0; k < 3; k++)
             ev->weight.c[k] *= sn[k] * sum / (c.mu * pn);
     }
-    return 0;
 }
 
-static murk_rgb spectral_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx,
-                                       murk_rng *rng)
-{
-    (void)ctx;
-    const spectral *m = self;
-    return murk_ratio_tracking(m->base.host, m->base.d, ray, 0.0f, rng);
-}
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, spectral_create, murk_tracker_free,
+                                  spectral_sample, murk_tracker_transmittance};
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), spectral_create, murk_tracker_free, spectral_sample,
-                                  spectral_transmittance};
-
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, "spectral",
-    "spectral tracking (Kutz et al. 2017): one majorant, per-channel weights", params, P_COUNT, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MEDIUM_PLUGIN("spectral", "spectral tracking (Kutz et al. 2017): one majorant, per-channel weights", params,
+                   P_COUNT, &vt)

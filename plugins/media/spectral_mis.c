@@ -26,14 +26,14 @@ static int smis_create(const murk_host *host, const murk_medium_data *data, cons
     return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
 }
 
-static int smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                       murk_medium_event *ev)
+static void smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                        murk_medium_event *ev)
 {
     const murk_tracker *m = self;
     int hero = ctx->hero;
     murk_event_init(ev, ray);
     if (!(m->smax > 0.0f))
-        return 0;
+        return;
     murk_collisions c;
     murk_collisions_init(&c, m, ray, m->smax); /* one majorant for every channel */
     float t, dens;
@@ -44,38 +44,25 @@ static int smis_sample(const void *self, const murk_ray *ray, const murk_path_ct
             q[k] = murk_real_prob(a[k], 1.0f - a[k]);
         }
         if (a[hero] > 1.0f)
-            m->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): spectral MIS uses "
-                               "weighted collisions (unbiased, noisier)", m->d->name);
+            murk_warn_majorant(m, "spectral MIS uses weighted collisions");
         if (murk_rng_float(rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
                 ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
-                ev->pdf.c[k] *= q[k] / q[hero];
+                ev->pdf_ratio.c[k] *= q[k] / q[hero];
             }
             ev->scattered = 1;
             ev->t = t;
-            return 1;
+            return;
         }
         for (int k = 0; k < 3; k++) {
             ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
-            ev->pdf.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
+            ev->pdf_ratio.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
         }
     }
-    return 0;
 }
 
-static murk_rgb smis_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
-{
-    (void)ctx;
-    const murk_tracker *m = self;
-    return murk_ratio_tracking(m->host, m->d, ray, 0.0f, rng);
-}
+static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, smis_create, murk_tracker_free,
+                                  smis_sample, murk_tracker_transmittance};
 
-static const murk_medium_vt vt = {sizeof(murk_medium_vt), smis_create, murk_tracker_free, smis_sample,
-                                  smis_transmittance};
-
-static const murk_plugin_desc desc = {
-    sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, "spectral_mis",
-    "spectral MIS (Miller et al. 2019): hero-channel tracking, balance heuristic over channels", NULL, 0, &vt,
-};
-
-MURK_PLUGIN(&desc)
+MURK_MEDIUM_PLUGIN("spectral_mis", "spectral MIS (Miller et al. 2019): hero-channel tracking, balance heuristic over channels",
+                   NULL, 0, &vt)

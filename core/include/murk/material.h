@@ -6,7 +6,11 @@
  * without the cosine; pdf() is the solid-angle density that sample() draws wi from; sample() returns 0
  * (and pdf 0) when it produces no direction — never an infinite weight. The path weight of a sample is
  * always f * |wi.z| / pdf; a delta lobe sets f and pdf so that this ratio is its reflectance (e.g. pdf =
- * the lobe's selection probability, f = F / |wi.z|) and sets `delta` so the integrator skips MIS. */
+ * the lobe's selection probability, f = F / |wi.z|) and sets `delta` so the integrator skips MIS.
+ * All three are called from every render thread at once (see murk/plugin.h); `hit` is valid for the
+ * call only and carries the texture coordinates that murk_value_eval() reads. u[] are three uniforms
+ * in [0, 1). Every returned number must be finite: murk names the material that returned NaN or
+ * infinity. */
 #ifndef MURK_MATERIAL_H
 #define MURK_MATERIAL_H
 
@@ -21,12 +25,18 @@ typedef struct murk_bsdf_sample {
 
 typedef struct murk_material_vt {
     uint32_t size; /* sizeof(murk_material_vt) of the plugin */
+    uint32_t kind; /* MURK_KIND_MATERIAL */
     murk_create_fn create;
     void (*destroy)(void *self);
     murk_rgb (*eval)(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi);
     float (*pdf)(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi);
     int (*sample)(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s);
 } murk_material_vt;
+
+#define MURK_MATERIAL_VT_SIZE_1_0 (offsetof(murk_material_vt, sample) + sizeof(void (*)(void)))
+#define MURK_MATERIAL_PLUGIN(NAME, DESCRIPTION, PARAMS, NPARAMS, VT)                               \
+    MURK_DEFINE_PLUGIN_(MURK_KIND_MATERIAL, NAME, DESCRIPTION, PARAMS, NPARAMS,                    \
+                        _Generic((VT), const murk_material_vt *: (VT), murk_material_vt *: (VT)))
 
 /* A material as the scene holds it. */
 struct murk_material {

@@ -11,7 +11,7 @@
  *   ev->weight = f / p_hero   per channel: the flight's contribution over the pdf it was sampled with
  *                             (for plain delta tracking: 1 through to the surface, the albedo at a
  *                             scattering event; 0 means the path was absorbed)
- *   ev->pdf    = p_k / p_hero per channel: the pdf channel k's own technique would have given this
+ *   ev->pdf_ratio = p_k / p_hero per channel: the pdf channel k's own technique would have given this
  *                             flight, relative to the one used. (1,1,1) for every tracker except the
  *                             per-channel ones (spectral_mis: the balance heuristic over channels;
  *                             naive_spectral: 1 for the path's hero channel, 0 for others, so the
@@ -23,7 +23,25 @@
  * once through host->warn_once.
  *
  * transmittance() returns an unbiased per-channel estimate of exp(-int sigma_t) over the segment
- * (ratio tracking or better), used on shadow rays. */
+ * (ratio tracking or better), used on shadow rays.
+ *
+ * Unbiased on coloured media. With chromatic extinction there is no single probability of a real
+ * collision: taking one channel's (or the average) sigma_t / majorant and giving the other channels
+ * weight 1 is biased. Reweight every channel by its own real / null share over the probability used
+ * (murk/tracking.h: murk_collision_choice does this with history-aware probabilities that keep the
+ * weights bounded).
+ *
+ * Contracts (besides those of murk/plugin.h):
+ *   create()        gets the core's data for the medium in `data`: valid, unchanged, until destroy().
+ *   sample()        samples a free flight over (ray->tmin, ray->tmax); ray->tmax may be INFINITY (the
+ *                   ray leaves the scene: outside the density field's box the density is 0, and the
+ *                   majorant walk ends there, so a tracker that walks the grid terminates; one that
+ *                   uses a single global majorant must stop at the field's box itself). It fills *ev
+ *                   completely. Called from every render thread at once: it must not modify self.
+ *   transmittance() same rules; returns finite, non-negative channels (0 = opaque: the shadow ray
+ *                   stops). Every loop must advance: the float spacing of t, not only the sampled
+ *                   step, decides progress once t is large.
+ * murk names the medium whose call returned a NaN or infinite weight. */
 #ifndef MURK_MEDIUM_H
 #define MURK_MEDIUM_H
 
@@ -34,12 +52,10 @@ typedef struct murk_density murk_density; /* opaque: a density field with its ma
 /* What the core gives every tracker at create(). Coefficients are per unit density, with the scene's
  * `scale` applied: sigma_t(x) = density(x) * (sigma_a + sigma_s). */
 typedef struct murk_medium_data {
-    uint32_t size;
+    uint32_t size;                /* sizeof(murk_medium_data) of the core */
     murk_rgb sigma_a, sigma_s;
     float g;                      /* Henyey-Greenstein asymmetry of the phase function */
-    float majorant_factor;        /* multiplies the majorant grid (>= 1 keeps it bounding) */
-    float density_max, density_min; /* over the whole field (min over its box; 0 outside it) */
-    const murk_density *density;
+    const murk_density *density;  /* the field with its majorant/minorant grid (majorant_factor applied) */
     const char *name;             /* the medium's name in the scene, for messages */
 } murk_medium_data;
 
@@ -50,10 +66,10 @@ typedef struct murk_medium_data {
 typedef struct murk_majorant_walk { uint64_t opaque[32]; } murk_majorant_walk;
 
 typedef struct murk_medium_event {
-    int scattered;   /* 1: a real scattering event at t; 0: the flight passed the segment's end */
-    float t;
-    murk_rgb weight; /* multiply into the path's beta (all 0: absorbed, the path ends) */
-    murk_rgb pdf;    /* multiply into the path's pdf ratios R; (1,1,1) for non-spectral-MIS trackers */
+    int scattered;      /* 1: a real scattering event at t; 0: the flight passed the segment's end */
+    float t;            /* where it scattered (ray->tmax when it passed) */
+    murk_rgb weight;    /* multiply into the path's beta (all 0: absorbed, the path ends) */
+    murk_rgb pdf_ratio; /* multiply into the path's pdf ratios R: (1,1,1) except for per-channel trackers */
 } murk_medium_event;
 
 /* Per-path state an integrator passes to trackers. */
@@ -64,17 +80,23 @@ typedef struct murk_path_ctx {
 
 typedef struct murk_medium_vt {
     uint32_t size; /* sizeof(murk_medium_vt) of the plugin */
+    uint32_t kind; /* MURK_KIND_MEDIUM */
     /* create() gets its own parameters in `params` and the core's data for the medium in `data`
      * (valid for the medium's whole life). */
     int (*create)(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
                   char *err, size_t errlen);
     void (*destroy)(void *self);
-    /* Samples a free flight along ray->d from ray->o over (ray->tmin, ray->tmax). */
-    int (*sample)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                  murk_medium_event *ev);
+    /* Samples a free flight along ray->d from ray->o over (ray->tmin, ray->tmax) into *ev. */
+    void (*sample)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                   murk_medium_event *ev);
     /* Unbiased per-channel transmittance estimate over (ray->tmin, ray->tmax). */
     murk_rgb (*transmittance)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng);
 } murk_medium_vt;
+
+#define MURK_MEDIUM_VT_SIZE_1_0 (offsetof(murk_medium_vt, transmittance) + sizeof(void (*)(void)))
+#define MURK_MEDIUM_PLUGIN(NAME, DESCRIPTION, PARAMS, NPARAMS, VT)                                 \
+    MURK_DEFINE_PLUGIN_(MURK_KIND_MEDIUM, NAME, DESCRIPTION, PARAMS, NPARAMS,                      \
+                        _Generic((VT), const murk_medium_vt *: (VT), murk_medium_vt *: (VT)))
 
 /* A medium as the scene holds it. */
 struct murk_medium {

@@ -1,15 +1,38 @@
 /* murk/plugin.h — the plugin ABI: version, descriptor, parameter schema, host services.
  *
- * A plugin is a shared object that exports exactly two symbols:
+ * A plugin is a shared object that exports exactly two symbols, both made by one of the typed macros
+ * at the end of this file (MURK_MATERIAL_PLUGIN, MURK_MEDIUM_PLUGIN, MURK_INTEGRATOR_PLUGIN):
  *
  *     MURK_EXPORT const murk_abi murk_plugin_abi = { MURK_ABI_MAJOR, MURK_ABI_MINOR };
  *     MURK_EXPORT const murk_plugin_desc *murk_plugin_entry(void);
  *
- * The host reads `murk_plugin_abi` (a data symbol) before it runs any plugin code: the major must equal
- * the host's and the minor must not exceed it. Then it calls murk_plugin_entry() once and checks the
- * descriptor (struct_size, kind, name == file basename, vtable size). Plugins never link against
- * libmurk: everything they need from the core arrives as the murk_host table passed to create().
- * Structs that cross the boundary start with a size field; fields and methods are only appended. */
+ * Loading. The host reads `murk_plugin_abi` (a data symbol) from the file before it runs any plugin
+ * code: the major must equal the host's and the minor must not exceed it. Then it dlopen()s the file
+ * (RTLD_NOW | RTLD_LOCAL), calls murk_plugin_entry() once and checks the descriptor: struct_size at
+ * least the ABI 1.0 size, a known kind, name == the file's basename, a vtable whose kind field equals
+ * the descriptor's kind and whose size is at least the kind's ABI 1.0 size, and a well-formed
+ * parameter schema. Plugins never link libmurk: everything they need from the core arrives as the
+ * murk_host table passed to create().
+ *
+ * Versioning (SQLite's iVersion pattern). Every struct that crosses the boundary starts with its size
+ * and only ever grows at the end. A minor version may append fields to structs and methods to
+ * vtables and the host table; it never moves, removes or changes the meaning of anything. So a plugin
+ * built against ABI 1.m loads in every host 1.n with n >= m: the host reads a descriptor's or
+ * vtable's size before touching a field appended after 1.0 (MURK_HAS), and a plugin reads
+ * host->size before calling a host service appended after 1.0. Anything else — a changed signature,
+ * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
+ *
+ * Contracts common to every kind:
+ *   create()  returns 0 and sets *self on success; on failure it returns non-zero, writes one line
+ *             (no file or position: the core adds `scene.yaml:LINE:COL: medium 'smoke': ` before it)
+ *             into err and leaves nothing allocated. It is called on the main thread.
+ *   params    an array in schema order (murk_value); it, its strings and its texture pointers stay
+ *             valid until destroy() returns, so an instance may keep pointers into it.
+ *   host      the murk_host table is static: valid for the whole process.
+ *   destroy() frees what create() made; called once, on the main thread, after all rendering.
+ *   Methods other than create()/destroy() are called from every render thread at once with the same
+ *   self: they must not modify the instance (keep per-call state on the stack).
+ *   Rays: ray->d is unit length; ray->tmax may be INFINITY (an open ray that leaves the scene). */
 #ifndef MURK_PLUGIN_H
 #define MURK_PLUGIN_H
 
@@ -158,22 +181,45 @@ typedef int (*murk_create_fn)(const murk_host *host, const murk_value *params, v
                               char *err, size_t errlen);
 
 typedef struct murk_plugin_desc {
-    uint32_t struct_size; /* sizeof(murk_plugin_desc) */
+    uint32_t struct_size; /* sizeof(murk_plugin_desc) of the plugin's headers */
     uint32_t kind;        /* murk_kind */
     const char *name;     /* the scene's `type:`; equals the file's basename */
-    const char *description;
+    const char *description; /* one line, shown by `murk plugins` */
     const murk_param *params;
     uint32_t nparams;
     const void *vtable;   /* murk_material_vt / murk_medium_vt / murk_integrator_vt */
 } murk_plugin_desc;
 
+/* Every vtable starts with these two fields. */
+typedef struct murk_vt_head {
+    uint32_t size; /* sizeof(the vtable) in the plugin's headers */
+    uint32_t kind; /* murk_kind: must equal the descriptor's */
+} murk_vt_head;
+
+/* 1 if a struct that starts with a size field (descriptor, vtable, host table) is large enough to
+ * hold `member`, i.e. the other side was built with a version that has it. */
+#define MURK_HAS(ptr, type, member) \
+    ((size_t)(ptr)->size >= offsetof(type, member) + sizeof(((const type *)0)->member))
+#define MURK_PLUGIN_DESC_SIZE_1_0 (offsetof(murk_plugin_desc, vtable) + sizeof(const void *))
+
 #define MURK_PLUGIN_ENTRY_SYMBOL "murk_plugin_entry"
 #define MURK_PLUGIN_ABI_SYMBOL "murk_plugin_abi"
 
-/* Declares the two exported symbols; use once per plugin: MURK_PLUGIN(&my_descriptor); */
+/* The two exported symbols for a descriptor; the typed macros below use it. */
 #define MURK_PLUGIN(desc_ptr)                                                            \
     MURK_EXPORT const murk_abi murk_plugin_abi = {MURK_ABI_MAJOR, MURK_ABI_MINOR};       \
     MURK_EXPORT const murk_plugin_desc *murk_plugin_entry(void);                         \
     const murk_plugin_desc *murk_plugin_entry(void) { return (desc_ptr); }
+
+/* Declares a plugin of one kind, once per plugin file, e.g.
+ *     static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, create, destroy, ...};
+ *     MURK_MEDIUM_PLUGIN("mytracker", "one-line description", params, NPARAMS, &vt)
+ * The vtable's type is checked at compile time (a material vtable under MURK_MEDIUM_PLUGIN does not
+ * compile). params may be NULL with nparams 0. The kind's header (murk/material.h, murk/medium.h or
+ * murk/integrator.h) defines the macro. */
+#define MURK_DEFINE_PLUGIN_(KIND, NAME, DESCRIPTION, PARAMS, NPARAMS, VT)                                      \
+    static const murk_plugin_desc murk_plugin_desc_ = {sizeof(murk_plugin_desc), (KIND), (NAME), (DESCRIPTION), \
+                                                       (PARAMS), (NPARAMS), (VT)};                              \
+    MURK_PLUGIN(&murk_plugin_desc_)
 
 #endif

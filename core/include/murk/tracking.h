@@ -1,6 +1,10 @@
-/* murk/tracking.h — small helpers for tracker (medium plugin) authors: free-flight distances,
- * weighted collision choices that stay unbiased when a majorant fails to bound, and ratio-tracking
- * transmittance over the core's majorant grid. Header-only; include after murk/medium.h. */
+/* murk/tracking.h — helpers for tracker (medium plugin) authors: the common tracker state, free-flight
+ * distances, collision choices that stay unbiased (and bounded) on coloured media and where a
+ * majorant fails to bound, the warning for that, and ratio-tracking transmittance over the core's
+ * majorant grid. Header-only; include after murk/medium.h.
+ *
+ * A tracker that walks the majorant grid itself (host->walk_init / walk_next) and reads the density
+ * with host->density() needs nothing else from here; these helpers are what murk's own trackers share. */
 #ifndef MURK_TRACKING_H
 #define MURK_TRACKING_H
 
@@ -14,6 +18,7 @@ typedef struct murk_tracker {
     const murk_medium_data *d;
     murk_rgb sigma_t; /* extinction per unit density */
     float smax;       /* its largest channel */
+    int grey;         /* 1 if sigma_t is the same in every channel */
 } murk_tracker;
 
 /* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
@@ -34,6 +39,7 @@ static inline void *murk_tracker_new(const murk_host *host, const murk_medium_da
     t->d = d;
     t->sigma_t = murk_rgb_add(d->sigma_a, d->sigma_s);
     t->smax = murk_rgb_max(t->sigma_t);
+    t->grey = t->sigma_t.c[0] == t->sigma_t.c[1] && t->sigma_t.c[1] == t->sigma_t.c[2];
     return t;
 }
 
@@ -50,7 +56,7 @@ static inline void murk_event_init(murk_medium_event *ev, const murk_ray *ray)
     ev->scattered = 0;
     ev->t = ray->tmax;
     ev->weight = murk_rgb1(1.0f);
-    ev->pdf = murk_rgb1(1.0f);
+    ev->pdf_ratio = murk_rgb1(1.0f);
 }
 
 /* Extinction per unit density. */
@@ -60,14 +66,43 @@ static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb
 static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-murk_rng_float(rng)) / mu; }
 
 /* Probability of taking the "real" branch of a collision whose real and null weights (each relative to
- * the majorant, real + null = 1) are a and b. For a bounding majorant (a, b >= 0) this is a itself:
- * plain delta tracking. When the majorant fails (b < 0, or a control above the density makes a < 0)
- * the branches are chosen in proportion to |a| and |b| and weighted by a/q and b/(1-q): still
- * unbiased, with weights that may exceed 1 or go negative. */
+ * the majorant, real + null = 1) are a and b, for ONE channel (grey extinction, or a tracker that
+ * follows one channel per path). For a bounding majorant (a, b >= 0) this is a itself: plain delta
+ * tracking. When the majorant fails (b < 0, or a control above the density makes a < 0) the branches
+ * are chosen in proportion to |a| and |b| and weighted by a/q and b/(1-q): still unbiased, with
+ * weights that may exceed 1 or go negative. For coloured extinction use murk_collision_prob. */
 static inline float murk_real_prob(float a, float b)
 {
     float s = fabsf(a) + fabsf(b);
     return s > 0.0f ? fabsf(a) / s : 0.0f;
+}
+
+/* Probability of the real branch of a collision whose real share in channel k is a[k] (the local
+ * sigma_t,k over the majorant; the null share is 1 - a[k]). Grey extinction: murk_real_prob(a[0]).
+ * Coloured: history-aware (Kutz et al. 2017), q = sum_k |h_k| |a_k| / sum_k |h_k| (|a_k| + |1 - a_k|)
+ * with h_k = beta_k x weight_k the path's weight so far in channel k — a plain channel average lets
+ * the weights grow without bound along a path. The caller then multiplies channel k's weight by
+ * a[k] / q (real) or (1 - a[k]) / (1 - q) (null), which keeps every channel unbiased. */
+static inline float murk_collision_prob(const murk_tracker *t, const float a[3], const murk_path_ctx *ctx,
+                                        murk_rgb weight)
+{
+    if (t->grey)
+        return murk_real_prob(a[0], 1.0f - a[0]);
+    float pr = 0.0f, pn = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        float h = fabsf(ctx->beta.c[k] * weight.c[k]);
+        pr += h * fabsf(a[k]);
+        pn += h * fabsf(1.0f - a[k]);
+    }
+    return pr + pn > 0.0f ? pr / (pr + pn) : 0.5f;
+}
+
+/* The warning for a density above the majorant (a real share above 1), once per run and medium;
+ * `what` says how the tracker copes, e.g. "delta tracking switches to weighted collisions". */
+static inline void murk_warn_majorant(const murk_tracker *t, const char *what)
+{
+    t->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): %s (unbiased, noisier)",
+                       t->d->name, what);
 }
 
 /* Tentative collisions along a ray: a Poisson process whose rate in each majorant cell is
@@ -163,6 +198,15 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
         }
     }
     return T;
+}
+
+/* The transmittance() of a tracker whose struct starts with a murk_tracker: plain ratio tracking. */
+static inline murk_rgb murk_tracker_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx,
+                                                  murk_rng *rng)
+{
+    (void)ctx;
+    const murk_tracker *t = self;
+    return murk_ratio_tracking(t->host, t->d, ray, 0.0f, rng);
 }
 
 #endif

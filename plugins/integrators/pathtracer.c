@@ -1,0 +1,375 @@
+/* pathtracer.c — the path tracer shared by the path, volpath and volpath_nee plugins (see
+ * pathtracer.h for what it computes). One function per kind of event along a path:
+ *
+ *   medium_vertex()    a free flight through the current medium (the tracker's sample()) and, if it
+ *                      scatters, next-event estimation and phase-function sampling there;
+ *   surface_vertex()   emission found at a surface (MIS-weighted against light sampling), then
+ *                      next-event estimation and BSDF sampling;
+ *   cross_boundary()   an index-matched boundary: change medium, go straight on;
+ *   sample_light()     next-event estimation from any scattering vertex, through murk_pt_shadow();
+ *   roulette()         Russian roulette.
+ *
+ * The functions with external linkage are hidden in the plugin (only the entry symbols are exported). */
+#include "pathtracer.h"
+
+#include <math.h>
+#include <stdio.h>
+
+#include "murk/material.h"
+
+const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
+    [MURK_PT_MAX_DEPTH] = {"max_depth", MURK_PARAM_INT, 0, {64, 0, 0}, NULL, NULL, 1, 100000,
+                           "most scattering events (surface or medium) per path"},
+    [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000,
+                          "scattering events before Russian roulette may end a path"},
+};
+
+int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int media, void **self, char *err,
+                   size_t errlen)
+{
+    if (host->size < sizeof(murk_host)) {
+        snprintf(err, errlen, "this murk's host table lacks the media services");
+        return -1;
+    }
+    murk_pt *pt = host->alloc(sizeof *pt);
+    if (!pt) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    pt->host = host;
+    pt->max_depth = (int)params[MURK_PT_MAX_DEPTH].f[0];
+    pt->rr_depth = (int)params[MURK_PT_RR_DEPTH].f[0];
+    pt->nee = nee;
+    pt->media = media;
+    *self = pt;
+    return 0;
+}
+
+void murk_pt_destroy(void *self)
+{
+    murk_pt *pt = self;
+    if (pt)
+        pt->host->free(pt);
+}
+
+/* ---- small helpers ------------------------------------------------------------------------- */
+
+static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
+
+/* p moved off its surface (normal n) to the side dir points to, by 1e-4 of its magnitude (at least). */
+static murk_vec3 offset(murk_vec3 p, murk_vec3 n, murk_vec3 dir)
+{
+    float eps = 1e-4f * murk_maxf(1.0f, maxabs(p));
+    return murk_madd(p, n, murk_dot(n, dir) >= 0.0f ? eps : -eps);
+}
+
+static float power_heuristic(float a, float b)
+{
+    float a2 = a * a, b2 = b * b;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+
+static float mean3(murk_rgb r) { return (r.c[0] + r.c[1] + r.c[2]) * (1.0f / 3.0f); }
+
+static int finite3(murk_rgb c) { return isfinite(c.c[0]) && isfinite(c.c[1]) && isfinite(c.c[2]); }
+
+/* A plugin returned NaN or infinity: say which (once per message; repeats are counted) and end the
+ * path, so that one broken call costs its path, not the image. */
+static int broken(const murk_host *h, const char *kind, const char *name, const char *what)
+{
+    h->warn_once("%s '%s' returned a non-finite %s: the path was ended there", kind, name, what);
+    return 0;
+}
+
+static murk_ray ray_from(murk_vec3 o, murk_vec3 d)
+{
+    murk_ray r;
+    r.o = o;
+    r.d = d;
+    r.tmin = 0.0f;
+    r.tmax = INFINITY;
+    return r;
+}
+
+/* ---- shadow rays --------------------------------------------------------------------------- */
+
+/* An origin offset along a boundary's normal is off the original line from p to q: a leg that kept
+ * the first direction, with a length measured along it, reaches a light parallel to the boundary
+ * early and counts the light itself as an occluder. So every leg is re-aimed at q. */
+murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
+                        const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    const murk_host *h = pt->host;
+    const float end_eps = 1e-4f * murk_maxf(1.0f, maxabs(q));
+    murk_rgb T = murk_rgb1(1.0f);
+    if (!pt->media)
+        m = NULL;
+    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, murk_sub(q, p)) : p;
+    for (int crossings = 0; crossings < 256; crossings++) {
+        murk_vec3 d = murk_sub(q, o);
+        float len = murk_length(d);
+        if (!(len > end_eps))
+            return T;
+        murk_ray r = ray_from(o, murk_mul(d, 1.0f / len));
+        r.tmax = len - end_eps;
+        if (!m && !h->occluded(scene, &r)) /* nothing at all in the way: the common case, cheaply */
+            return T;
+        murk_hit hit;
+        int found = h->intersect(scene, &r, &hit);
+        if (found && hit.material)
+            return murk_rgb1(0.0f);
+        if (m) {
+            murk_ray seg = r;
+            seg.tmax = found ? hit.t : r.tmax;
+            murk_rgb Tm = m->vt->transmittance(m->self, &seg, ctx, rng);
+            if (!finite3(Tm))
+                return murk_rgb1((float)broken(h, "medium", m->name, "transmittance"));
+            T = murk_rgb_mul(T, Tm);
+            if (murk_rgb_is_black(T))
+                return T;
+        }
+        if (!found)
+            return T;
+        if (pt->media)
+            m = murk_dot(r.d, hit.ng) < 0.0f ? hit.interior : hit.exterior;
+        o = offset(hit.p, hit.ng, r.d);
+    }
+    return murk_rgb1(0.0f); /* a maze of boundaries: give up (never seen in a real scene) */
+}
+
+/* ---- path state ---------------------------------------------------------------------------- */
+
+typedef struct path {
+    murk_rgb L, beta, R;
+    murk_path_ctx ctx;
+    const murk_medium *medium; /* where the ray's origin lies (NULL: vacuum) */
+    murk_ray ray;
+    /* the last scattering vertex, for the MIS weight of emission that BSDF / phase sampling finds */
+    murk_vec3 prev_p;
+    float prev_pdf;
+    int prev_delta; /* 1 at the camera and after a delta lobe: no light sample competed */
+    int depth, crossings;
+} path;
+
+/* L += beta * le * w / mean(R) */
+static void add_light(path *st, murk_rgb le, float w)
+{
+    st->L = murk_rgb_add(st->L, murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R)));
+}
+
+/* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side) or
+ * the medium's phase function (mat == NULL). */
+typedef struct vertex {
+    murk_vec3 p, offset_n, wo; /* offset_n: the geometric normal at a surface, zero in a medium */
+    const murk_material *mat;
+    const murk_hit *hit;
+    murk_vec3 t, b, n, wo_local;
+    float g;
+} vertex;
+
+/* f |cos| towards the world direction wi (the phase function in a medium). */
+static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
+{
+    if (!v->mat)
+        return murk_rgb1(h->phase_eval(v->g, v->wo, wi));
+    if (murk_dot(wi, v->offset_n) <= 0.0f) /* materials only reflect */
+        return murk_rgb1(0.0f);
+    murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
+    return murk_rgb_scale(v->mat->vt->eval(v->mat->self, v->hit, v->wo_local, wl), fabsf(wl.z));
+}
+
+/* The solid-angle pdf with which the vertex samples wi. */
+static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
+{
+    if (!v->mat)
+        return h->phase_eval(v->g, v->wo, wi);
+    return v->mat->vt->pdf(v->mat->self, v->hit, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
+}
+
+/* Next-event estimation from v: a light point, the transmittance to it, the power heuristic against
+ * the vertex's own sampling. */
+static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, murk_rng *rng)
+{
+    const murk_host *h = pt->host;
+    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    murk_light_sample ls;
+    if (!h->sample_light(scene, v->p, u, &ls))
+        return;
+    murk_rgb f = vertex_f(h, v, ls.wi);
+    if (!finite3(f)) {
+        broken(h, "material", v->mat ? v->mat->name : "(phase)", "BSDF value");
+        return;
+    }
+    if (murk_rgb_is_black(f))
+        return;
+    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls.wi, ls.dist), st->medium, &st->ctx,
+                                rng);
+    if (murk_rgb_is_black(T))
+        return;
+    float pdf = vertex_pdf(h, v, ls.wi);
+    if (!isfinite(pdf)) {
+        broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
+        return;
+    }
+    float w = power_heuristic(ls.pdf, pdf) / ls.pdf;
+    add_light(st, murk_rgb_mul(murk_rgb_mul(f, T), ls.le), w);
+}
+
+/* ---- events ---------------------------------------------------------------------------------- */
+
+enum { PT_END, PT_PASSED, PT_SCATTERED };
+
+/* A free flight through st->medium up to tmax (the next surface, or INFINITY). */
+static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, float tmax, murk_rng *rng)
+{
+    const murk_host *h = pt->host;
+    const murk_medium *m = st->medium;
+    murk_ray seg = st->ray;
+    seg.tmax = tmax;
+    murk_medium_event ev;
+    st->ctx.beta = st->beta;
+    m->vt->sample(m->self, &seg, &st->ctx, rng, &ev);
+    if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t))) {
+        broken(h, "medium", m->name, "free-flight weight");
+        return PT_END;
+    }
+    st->beta = murk_rgb_mul(st->beta, ev.weight);
+    st->R = murk_rgb_mul(st->R, ev.pdf_ratio);
+    if (murk_rgb_is_black(st->beta) || !(mean3(st->R) > 0.0f))
+        return PT_END;
+    if (!ev.scattered)
+        return PT_PASSED;
+    if (st->depth >= pt->max_depth)
+        return PT_END;
+    vertex v = {0};
+    v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
+    v.wo = murk_neg(st->ray.d);
+    v.g = m->data->g;
+    if (pt->nee)
+        sample_light(pt, scene, st, &v, rng);
+    float u[2] = {murk_rng_float(rng), murk_rng_float(rng)}, pdf;
+    murk_vec3 wi = h->phase_sample(v.g, v.wo, u, &pdf);
+    if (!(pdf > 0.0f))
+        return PT_END;
+    /* HG is sampled exactly: phase / pdf = 1, beta stays */
+    st->prev_p = v.p;
+    st->prev_pdf = pdf;
+    st->prev_delta = 0;
+    st->ray = ray_from(v.p, wi);
+    st->depth++;
+    return PT_SCATTERED;
+}
+
+/* Emission at a surface hit, then (below max_depth) light sampling and BSDF sampling. Returns 0 when
+ * the path ends. */
+static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, const murk_hit *hit, murk_rng *rng)
+{
+    const murk_host *h = pt->host;
+    murk_vec3 wo = murk_neg(st->ray.d);
+    murk_rgb le = murk_hit_le(hit, wo);
+    if (!murk_rgb_is_black(le))
+        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf(scene, st->prev_p, hit))
+                                                     : 1.0f);
+    if (st->depth >= pt->max_depth)
+        return 0;
+    vertex v = {0};
+    v.p = hit->p;
+    v.wo = wo;
+    v.mat = hit->material;
+    v.hit = hit;
+    v.offset_n = hit->ng;
+    v.n = hit->n;
+    if (murk_dot(v.offset_n, wo) < 0.0f) { /* the frame on wo's side: two-sided materials */
+        v.offset_n = murk_neg(v.offset_n);
+        v.n = murk_neg(v.n);
+    }
+    murk_basis(v.n, &v.t, &v.b);
+    v.wo_local = murk_to_local(wo, v.t, v.b, v.n);
+    if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
+        v.wo_local.z = 1e-6f;
+    if (pt->nee)
+        sample_light(pt, scene, st, &v, rng);
+    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    murk_bsdf_sample bs;
+    if (!v.mat->vt->sample(v.mat->self, hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
+        return 0;
+    if (!finite3(bs.f) || !isfinite(bs.pdf) || !isfinite(bs.wi.x + bs.wi.y + bs.wi.z))
+        return broken(h, "material", v.mat->name, "sample");
+    murk_vec3 wi = murk_from_local(bs.wi, v.t, v.b, v.n);
+    if (murk_dot(wi, v.offset_n) <= 0.0f)
+        return 0;
+    st->beta = murk_rgb_mul(st->beta, murk_rgb_scale(bs.f, fabsf(bs.wi.z) / bs.pdf));
+    st->prev_p = hit->p;
+    st->prev_pdf = bs.pdf;
+    st->prev_delta = bs.delta;
+    st->ray = ray_from(offset(hit->p, v.offset_n, wi), wi);
+    st->depth++;
+    return 1;
+}
+
+/* An index-matched boundary: the medium on the far side, the same direction. */
+static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
+{
+    if (++st->crossings > 1000)
+        return 0;
+    if (pt->media)
+        st->medium = murk_dot(st->ray.d, hit->ng) < 0.0f ? hit->interior : hit->exterior;
+    st->ray = ray_from(offset(hit->p, hit->ng, st->ray.d), st->ray.d);
+    return 1;
+}
+
+/* After rr_depth events a path survives with probability q = max_c |beta_c| / mean(R) (at least 0.05,
+ * at most 1) and is divided by it. Returns 0 when the path ends. */
+static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
+{
+    if (st->depth > pt->rr_depth) {
+        murk_rgb b = st->beta;
+        float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) / mean3(st->R);
+        q = murk_maxf(0.05f, murk_minf(1.0f, q));
+        if (murk_rng_float(rng) >= q)
+            return 0;
+        st->beta = murk_rgb_scale(st->beta, 1.0f / q);
+    }
+    return !murk_rgb_is_black(st->beta);
+}
+
+murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *ray, murk_rng *rng)
+{
+    const murk_pt *pt = self;
+    const murk_host *h = pt->host;
+    path st = {0};
+    st.beta = st.R = murk_rgb1(1.0f);
+    st.ctx.hero = (int)(murk_rng_float(rng) * 3.0f);
+    if (st.ctx.hero > 2)
+        st.ctx.hero = 2;
+    st.medium = pt->media ? h->camera_medium(scene) : NULL;
+    st.ray = *ray;
+    st.prev_p = ray->o;
+    st.prev_delta = 1;
+    for (;;) {
+        murk_hit hit;
+        int found = h->intersect(scene, &st.ray, &hit);
+        if (st.medium) {
+            int ev = medium_vertex(pt, scene, &st, found ? hit.t : INFINITY, rng);
+            if (ev == PT_END)
+                break;
+            if (ev == PT_SCATTERED) {
+                if (!roulette(pt, &st, rng))
+                    break;
+                continue;
+            }
+        }
+        if (!found) {
+            add_light(&st, h->background(scene, st.ray.d), 1.0f);
+            break;
+        }
+        if (!hit.material) {
+            if (!cross_boundary(pt, &st, &hit))
+                break;
+            continue;
+        }
+        if (!surface_vertex(pt, scene, &st, &hit, rng) || !roulette(pt, &st, rng))
+            break;
+    }
+    return st.L;
+}

@@ -1,0 +1,52 @@
+/* pathtracer.h — the path tracer behind the `path`, `volpath` and `volpath_nee` integrator plugins.
+ * Compiled into each of the three modules (and into the tests); not a public header.
+ *
+ * A path carries an RGB weight beta and RGB pdf ratios R (both start at 1; see murk/medium.h) and
+ * credits emitted radiance Le as beta * Le / mean(R). A hero channel is drawn uniformly per path for
+ * the trackers that sample per channel.
+ *
+ * Media are tracked through index-matched boundaries (shapes with no material): crossing against the
+ * normal enters `interior`, along it leaves to `exterior`; the camera starts in the scene's camera
+ * medium. Materials only reflect, so a surface never changes the medium.
+ *
+ * With nee = 1 every scattering vertex (surface or medium) also samples a light point and estimates
+ * the transmittance to it (murk_pt_shadow); the light sample and the BSDF / phase sample are weighted
+ * by the power heuristic on their solid-angle pdfs (unbiased: the weights depend on the direction
+ * only and sum to 1). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
+ * independent estimator of the same image. With media = 0 (`path`) media are ignored and boundaries
+ * passed straight through, by paths and shadow rays alike. Russian roulette after rr_depth events on
+ * the path's largest channel weight over mean(R); survivors are divided by the survival probability. */
+#ifndef MURK_PATHTRACER_H
+#define MURK_PATHTRACER_H
+
+#include "murk/integrator.h"
+#include "murk/medium.h"
+
+/* The parameters all three integrators share (documented in each plugin's comment block). */
+enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_NPARAMS };
+extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
+
+typedef struct murk_pt {
+    const murk_host *host;
+    int max_depth, rr_depth;
+    int nee;   /* sample lights at every scattering vertex */
+    int media; /* track media (0: surfaces only, boundaries are invisible) */
+} murk_pt;
+
+/* create() for an integrator with the given strategy; destroy() for all of them. */
+int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int media, void **self, char *err,
+                   size_t errlen);
+void murk_pt_destroy(void *self);
+
+/* Radiance along a camera ray (the integrator vtable's li()). */
+murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *ray, murk_rng *rng);
+
+/* Transmittance of a shadow ray from p to the point q (on a light): 0 if a surface with a material
+ * blocks the way, else the product of the media's transmittance() estimates over the legs between
+ * index-matched boundaries. m: the medium at p (ignored, like every medium, when pt->media = 0).
+ * offset_n: the normal to offset a surface point along, or a zero vector for a point in a medium.
+ * Every leg is aimed at q itself and stops 1e-4 max(1, |q|_inf) short of it. */
+murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
+                        const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
+
+#endif
