@@ -10,8 +10,8 @@
  * reduce every 8/16-bit grey, grey+alpha, RGB, RGBA or palette image to 8-bit RGB, then maps it to
  * linear floats (the exact sRGB EOTF, or v/255).
  *
- * Both writers write PATH.tmp-PID, flush it to disk and rename it over PATH only when all of it was
- * written; on any failure the temporary is removed and PATH is left as it was.
+ * Both writers fill a temporary through murk_write_atomic (atomic.h), which renames it over PATH only
+ * when all of it was written; on any failure PATH is left as it was.
  *
  * Errors: OpenEXRCore reports details through a callback. Reads route its first message into the
  * caller's buffer (the file is read through our own pread callbacks, so open/read failures carry
@@ -20,6 +20,7 @@
  * message names the failing step plus the library's text for the result code. libpng errors
  * longjmp back into small functions whose caller owns every resource, so nothing leaks. */
 #include "image.h"
+#include "atomic.h"
 #include "error.h"
 #include "util.h"
 
@@ -42,16 +43,6 @@
 /* ---------------------------------------------------------------------------------------------- */
 /* Shared helpers                                                                                   */
 
-/* PATH.tmp-PID, malloc'd; NULL when out of memory. */
-static char *tmp_name(const char *path)
-{
-    size_t n = strlen(path) + 32;
-    char *tmp = malloc(n);
-    if (tmp)
-        snprintf(tmp, n, "%s.tmp-%ld", path, (long)getpid());
-    return tmp;
-}
-
 static char *dup_n(const char *s, size_t n)
 {
     char *d = malloc(n + 1);
@@ -67,27 +58,6 @@ static int size_ok(long long w, long long h)
 {
     return w > 0 && h > 0 && w <= INT_MAX / 12 && h <= INT_MAX &&
            (unsigned long long)w * (unsigned long long)h <= SIZE_MAX / 12;
-}
-
-/* Flushes a completely written temporary to disk and closes it (fd is closed in any case). */
-static int sync_close(int fd, const char *tmp, const char *path, char *err, size_t errlen)
-{
-    int rc = 0;
-    if (fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        rc = murk_err_file(err, errlen, path, "cannot sync %s: %s", tmp, strerror(errno));
-    if (close(fd) != 0 && rc == 0)
-        rc = murk_err_file(err, errlen, path, "cannot close %s: %s", tmp, strerror(errno));
-    return rc;
-}
-
-/* Renames the closed temporary over path when rc is 0; removes it otherwise or if that fails. */
-static int commit_tmp(int rc, const char *tmp, const char *path, char *err, size_t errlen)
-{
-    if (rc == 0 && rename(tmp, path) != 0)
-        rc = murk_err_file(err, errlen, path, "cannot rename %s: %s", tmp, strerror(errno));
-    if (rc != 0)
-        unlink(tmp);
-    return rc;
 }
 
 const char *murk_image_meta(const murk_image *img, const char *key)
@@ -311,27 +281,23 @@ static exr_result_t exr_write_file(exr_io *io, const char *tmp, const float *rgb
     return rv != EXR_ERR_SUCCESS ? rv : frv;
 }
 
-/* Writes the whole file to tmp with the given compression; 0, or -1 with err. */
-static int exr_write_tmp(const char *path, const char *tmp, const float *rgb, int w, int h, const murk_kv *meta,
-                         int nmeta, exr_compression_t comp, char *err, size_t errlen)
+/* Writes the whole file through fd (the temporary tmp) with the given compression; 0, or -1 with err. */
+static int exr_write_tmp(const char *path, int fd, const char *tmp, const float *rgb, int w, int h,
+                         const murk_kv *meta, int nmeta, exr_compression_t comp, char *err, size_t errlen)
 {
     exr_io io;
     memset(&io, 0, sizeof io);
-    io.fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (io.fd < 0)
-        return murk_err_file(err, errlen, path, "cannot create %s: %s", tmp, strerror(errno));
+    io.fd = fd;
+    if (ftruncate(fd, 0) != 0)
+        return murk_err_file(err, errlen, path, "cannot write %s: %s", tmp, strerror(errno));
     const char *step = "", *what = NULL;
     exr_result_t rv = exr_write_file(&io, tmp, rgb, w, h, meta, nmeta, comp, &step, &what);
-    if (rv != EXR_ERR_SUCCESS) {
-        const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
-        if (what)
-            murk_err_file(err, errlen, path, "EXR error %s '%.64s': %s", step, what, why);
-        else
-            murk_err_file(err, errlen, path, "EXR error %s: %s", step, why);
-        close(io.fd);
-        return -1;
-    }
-    return sync_close(io.fd, tmp, path, err, errlen);
+    if (rv == EXR_ERR_SUCCESS)
+        return 0;
+    const char *why = io.err ? strerror(io.err) : exr_get_default_error_message(rv);
+    if (what)
+        return murk_err_file(err, errlen, path, "EXR error %s '%.64s': %s", step, what, why);
+    return murk_err_file(err, errlen, path, "EXR error %s: %s", step, why);
 }
 
 /* 1 if the file at tmp holds exactly these pixels. */
@@ -346,25 +312,36 @@ static int exr_verify(const char *tmp, const float *rgb, int w, int h)
     return same;
 }
 
+typedef struct exr_job {
+    const char *path;
+    const float *rgb;
+    int w, h, nmeta;
+    const murk_kv *meta;
+} exr_job;
+
+/* Fills the temporary: ZIP, read back and checked bit for bit. OpenEXRCore 3.1's ZIP encoder can
+ * store a chunk whose zlib output is as large as its input in a form its decoder misreads (openexr
+ * issue 2306). If the check fails, the file is written again uncompressed. */
+static int exr_fill(FILE *fp, const char *tmp, void *user, char *err, size_t errlen)
+{
+    const exr_job *j = user;
+    int fd = fileno(fp);
+    int rc = exr_write_tmp(j->path, fd, tmp, j->rgb, j->w, j->h, j->meta, j->nmeta, EXR_COMPRESSION_ZIP, err, errlen);
+    if (rc == 0 && !exr_verify(tmp, j->rgb, j->w, j->h))
+        rc = exr_write_tmp(j->path, fd, tmp, j->rgb, j->w, j->h, j->meta, j->nmeta, EXR_COMPRESSION_NONE, err,
+                           errlen);
+    if (rc == 0 && !exr_verify(tmp, j->rgb, j->w, j->h))
+        rc = murk_err_file(err, errlen, j->path, "the EXR written does not read back identically");
+    return rc;
+}
+
 MURK_API int murk_exr_write(const char *path, const float *rgb, int w, int h, const murk_kv *meta, int nmeta,
-                   char *err, size_t errlen)
+                            char *err, size_t errlen)
 {
     if (!path || !rgb || !size_ok(w, h) || nmeta < 0 || (nmeta > 0 && !meta))
         return murk_err_file(err, errlen, path ? path : "(null)", "invalid image (%dx%d)", w, h);
-    char *tmp = tmp_name(path);
-    if (!tmp)
-        return murk_err_file(err, errlen, path, "out of memory");
-    /* ZIP, read back and checked bit for bit: OpenEXRCore 3.1's ZIP encoder can store a chunk whose
-     * zlib output is as large as its input in a form its decoder misreads (openexr issue 2306). If
-     * the check fails, the file is written again uncompressed. */
-    int rc = exr_write_tmp(path, tmp, rgb, w, h, meta, nmeta, EXR_COMPRESSION_ZIP, err, errlen);
-    if (rc == 0 && !exr_verify(tmp, rgb, w, h))
-        rc = exr_write_tmp(path, tmp, rgb, w, h, meta, nmeta, EXR_COMPRESSION_NONE, err, errlen);
-    if (rc == 0 && !exr_verify(tmp, rgb, w, h))
-        rc = murk_err_file(err, errlen, path, "the EXR written does not read back identically");
-    rc = commit_tmp(rc, tmp, path, err, errlen);
-    free(tmp);
-    return rc;
+    exr_job j = {path, rgb, w, h, nmeta, meta};
+    return murk_write_atomic(path, exr_fill, &j, err, errlen);
 }
 
 /* Decodes one chunk whose top-left pixel is (x0, y0) of the data window into img->rgb. slots[c] is
@@ -647,44 +624,43 @@ static int png_encode(png_job *j, const float *rgb, int w, int h, double scale)
     return 0;
 }
 
-MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen)
+typedef struct png_out {
+    const float *rgb;
+    int w, h;
+    float exposure;
+    const char *path;
+} png_out;
+
+/* Fills the temporary with the encoded preview. */
+static int png_fill(FILE *fp, const char *tmp, void *user, char *err, size_t errlen)
 {
-    if (!path || !rgb || !size_ok(w, h))
-        return murk_err_file(err, errlen, path ? path : "(null)", "invalid image (%dx%d)", w, h);
-    char *tmp = tmp_name(path);
-    if (!tmp)
-        return murk_err_file(err, errlen, path, "out of memory");
+    const png_out *o = user;
     png_job j;
+    int rc = 0;
+    (void)tmp;
     memset(&j, 0, sizeof j);
-    int rc = 0, fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd < 0) {
-        murk_err_file(err, errlen, path, "cannot create %s: %s", tmp, strerror(errno));
-        free(tmp);
-        return -1;
-    }
-    j.fp = fdopen(fd, "wb");
-    j.pix = malloc((size_t)w * 3);
-    if (j.fp)
-        j.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &j, png_error_cb, png_warning_cb);
+    j.fp = fp;
+    j.pix = malloc((size_t)o->w * 3);
+    j.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &j, png_error_cb, png_warning_cb);
     if (j.png)
         j.info = png_create_info_struct(j.png);
-    if (!j.fp || !j.pix || !j.png || !j.info)
-        rc = murk_err_file(err, errlen, path, "out of memory");
-    else if (png_encode(&j, rgb, w, h, exp2((double)exposure)) != 0)
-        rc = murk_err_file(err, errlen, path, "cannot write PNG: %s", j.msg[0] ? j.msg : "libpng error");
+    if (!j.pix || !j.png || !j.info)
+        rc = murk_err_file(err, errlen, o->path, "out of memory");
+    else if (png_encode(&j, o->rgb, o->w, o->h, exp2((double)o->exposure)) != 0)
+        rc = murk_err_file(err, errlen, o->path, "cannot write PNG: %s", j.msg[0] ? j.msg : "libpng error");
     if (j.png)
         png_destroy_write_struct(&j.png, j.info ? &j.info : NULL);
     free(j.pix);
-    if (rc == 0 && (fflush(j.fp) != 0 || ferror(j.fp)))
-        rc = murk_err_file(err, errlen, path, "cannot write %s: %s", tmp, strerror(errno));
-    if (rc == 0 && fsync(fd) != 0 && errno != EINVAL && errno != EROFS)
-        rc = murk_err_file(err, errlen, path, "cannot sync %s: %s", tmp, strerror(errno));
-    int closed = j.fp ? fclose(j.fp) : close(fd);
-    if (closed != 0 && rc == 0)
-        rc = murk_err_file(err, errlen, path, "cannot close %s: %s", tmp, strerror(errno));
-    rc = commit_tmp(rc, tmp, path, err, errlen);
-    free(tmp);
     return rc;
+}
+
+MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err,
+                            size_t errlen)
+{
+    if (!path || !rgb || !size_ok(w, h))
+        return murk_err_file(err, errlen, path ? path : "(null)", "invalid image (%dx%d)", w, h);
+    png_out o = {rgb, w, h, exposure, path};
+    return murk_write_atomic(path, png_fill, &o, err, errlen);
 }
 
 /* The libpng calls of a read into j->pix (allocated here, freed by the caller). */

@@ -10,6 +10,7 @@
  *         grid buffer is read with PNanoVDB (the C port of NanoVDB), bounds-checked, so a corrupt
  *         file yields zeros or an error rather than a wild read. */
 #include "density.h"
+#include "atomic.h"
 #include "error.h"
 #include "util.h"
 
@@ -295,32 +296,17 @@ fail:
     return NULL;
 }
 
-MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
+typedef struct vol_out {
+    const char *path;
+    const murk_field *f;
+} vol_out;
+
+/* Fills the temporary with the header and the voxels of a grid field. */
+static int vol_fill(FILE *fp, const char *tmp, void *user, char *err, size_t errlen)
 {
-    if (!f || f->kind != FIELD_GRID) {
-        murk_err_file(err, errlen, path, "only grid fields can be saved as .vol (this one is constant)");
-        return -1;
-    }
-    size_t plen = strlen(path);
-    char *tmp = malloc(plen + 16);
-    if (!tmp) {
-        murk_err_file(err, errlen, path, "out of memory");
-        return -1;
-    }
-    snprintf(tmp, plen + 16, "%s.tmp-XXXXXX", path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        murk_err_file(err, errlen, path, "cannot create a temporary file: %s", strerror(errno));
-        free(tmp);
-        return -1;
-    }
-    (void)fchmod(fd, 0644); /* mkstemp creates 0600; a saved grid is an ordinary file */
-    FILE *fp = fdopen(fd, "wb");
-    if (!fp) {
-        murk_err_file(err, errlen, path, "%s", strerror(errno));
-        close(fd);
-        goto fail;
-    }
+    const vol_out *o = user;
+    const murk_field *f = o->f;
+    (void)tmp;
     errno = 0;
     unsigned char h[VOL_HEADER];
     memcpy(h, "VOL", 3);
@@ -343,27 +329,17 @@ MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *er
             wr_f32(buf + 4 * k, f->data[i]);
         ok = fwrite(buf, 4, k, fp) == k;
     }
-    if (fflush(fp) != 0 || fsync(fileno(fp)) != 0)
-        ok = 0;
-    int saved_errno = errno;
-    if (fclose(fp) != 0)
-        ok = 0;
-    if (!ok) {
-        if (!saved_errno)
-            saved_errno = errno;
-        murk_err_file(err, errlen, path, "write error: %s", saved_errno ? strerror(saved_errno) : "I/O error");
-        goto fail;
-    }
-    if (rename(tmp, path) != 0) {
-        murk_err_file(err, errlen, path, "%s", strerror(errno));
-        goto fail;
-    }
-    free(tmp);
+    if (!ok)
+        return murk_err_file(err, errlen, o->path, "write error: %s", errno ? strerror(errno) : "I/O error");
     return 0;
-fail:
-    unlink(tmp);
-    free(tmp);
-    return -1;
+}
+
+MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
+{
+    if (!f || f->kind != FIELD_GRID)
+        return murk_err_file(err, errlen, path, "only grid fields can be saved as .vol (this one is constant)");
+    vol_out o = {path, f};
+    return murk_write_atomic(path, vol_fill, &o, err, errlen);
 }
 
 /* ---- NanoVDB -------------------------------------------------------------------------------- */
