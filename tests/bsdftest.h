@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "murk/material.h"
+#include "sphere.h"
 #include "testutil.h"
 
 /* ---- Instances ------------------------------------------------------------------------------- */
@@ -64,13 +65,9 @@ murk_vec3 bt_dir(double theta, double phi);
  * tolerance max(tol, 1e-6 |integral|) (tol in units of the integrand times steradians), within a fixed
  * budget of subintervals; the error estimates (|K15 - G7| summed, inner errors propagated) are
  * reported, also where the budget stopped the refinement. */
-typedef struct bt_grid {
-    int ntheta, nphi;
-    murk_vec3 pole; /* unit; {0,0,0} means +z */
-    double warp;    /* >= 1; 0 means 1 */
-} bt_grid;
+typedef murk_sph_grid bt_grid; /* ntheta, nphi, pole, warp: see core/check/sphere.h */
 
-typedef double (*bt_fn)(void *ctx, murk_vec3 w);
+typedef murk_sph_fn bt_fn;
 
 /* Integral of fn over one cell (it, ip); *err receives the summed error estimate. */
 double bt_integrate_cell(bt_fn fn, void *ctx, const bt_grid *g, int it, int ip, double tol, double *err);

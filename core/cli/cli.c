@@ -5,6 +5,7 @@
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
+#include "check.h"
 #include "cli.h"
 #include "density.h"
 #include "image.h"
@@ -26,6 +27,7 @@ static const char usage_text[] =
     "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
     "  murk plugins [NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+    "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
     "  murk --version\n";
 
@@ -493,6 +495,8 @@ int murk_cli_main(int argc, char **argv)
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return cmd_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "check"))
+        return murk_check_main(argc - 1, argv + 1);
     if (!strcmp(cmd, "grid"))
         return cmd_grid(argc - 2, argv + 2);
     if (!strcmp(cmd, "--version")) {

@@ -1,0 +1,100 @@
+#!/bin/sh
+# test_sdk.sh — the plugin author's path of docs/plugins.md, end to end, against an INSTALLED murk:
+#   1. `meson install --destdir` this build into a fresh temporary folder;
+#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0);
+#   3. copy the installed share/murk/examples, build them out of tree with their own meson.build and
+#      the installed murk-plugin.pc (PKG_CONFIG_PATH into the temporary prefix);
+#   4. the installed murk lists them (MURK_PLUGIN_PATH), `murk check`s each one, and renders a scene
+#      that names all three (material, tracker, integrator).
+# Usage: test_sdk.sh MESON   (the meson executable); MURK_BUILD_ROOT is the build folder (meson test
+# sets it). Writes nothing outside one temporary folder, which it removes.
+set -eu
+MESON=${1:-meson}
+BUILD=${MURK_BUILD_ROOT:?MURK_BUILD_ROOT must name the build folder}
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/murk-sdk-XXXXXX")
+trap 'rm -rf "$TMP"' EXIT INT TERM
+export TMPDIR="$TMP" # murk check's scratch folder too
+step() { printf '== %s\n' "$*"; }
+fail() { printf 'FAIL: %s\n' "$*"; exit 1; }
+
+step "meson install --destdir $TMP/root"
+"$MESON" install -C "$BUILD" --destdir "$TMP/root" --no-rebuild --quiet >"$TMP/install.log" 2>&1 ||
+  { cat "$TMP/install.log"; fail "meson install"; }
+MURK=$(find "$TMP/root" -type f -name murk -path '*/bin/murk' | head -n 1)
+PCFILE=$(find "$TMP/root" -name murk-plugin.pc | head -n 1)
+EXAMPLES=$(find "$TMP/root" -type d -path '*/share/murk/examples' | head -n 1)
+BUILTINS=$(find "$TMP/root" -type f -name diffuse.so -path '*/murk/plugins/*' | head -n 1)
+[ -n "$MURK" ] || fail "no bin/murk installed"
+[ -n "$PCFILE" ] || fail "no murk-plugin.pc installed"
+[ -n "$EXAMPLES" ] || fail "no share/murk/examples installed"
+[ -n "$BUILTINS" ] || fail "no built-in plugins installed"
+BUILTINS=$(dirname "$BUILTINS")
+
+step "the installed murk finds libmurk through its RPATH"
+readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
+env -u LD_LIBRARY_PATH "$MURK" --version || fail "installed murk does not start (RPATH?)"
+
+step "murk-plugin.pc: headers, -lm, hidden visibility, no -lmurk"
+export PKG_CONFIG_PATH="$(dirname "$PCFILE")"
+export PKG_CONFIG_SYSROOT_DIR="$TMP/root" # the files name the real prefix; they live under the destdir
+LIBS=$(pkg-config --libs murk-plugin)
+CFLAGS=$(pkg-config --cflags murk-plugin)
+echo "cflags: $CFLAGS"
+echo "libs: $LIBS"
+echo "plugindir: $(pkg-config --variable=plugindir murk-plugin), ABI $(pkg-config --variable=abi_major murk-plugin).$(pkg-config --variable=abi_minor murk-plugin)"
+case " $LIBS " in *" -lmurk "*) fail "murk-plugin links libmurk" ;; esac
+case " $LIBS " in *" -lm "*) ;; *) fail "murk-plugin lacks -lm" ;; esac
+case " $CFLAGS " in *"-fvisibility=hidden"*) ;; *) fail "murk-plugin lacks -fvisibility=hidden" ;; esac
+
+step "build the installed examples out of tree"
+cp -R "$EXAMPLES" "$TMP/examples"
+"$MESON" setup "$TMP/examples/build" "$TMP/examples" >"$TMP/setup.log" 2>&1 || { cat "$TMP/setup.log"; fail "meson setup of the examples"; }
+"$MESON" compile -C "$TMP/examples/build" >"$TMP/compile.log" 2>&1 || { cat "$TMP/compile.log"; fail "building the examples"; }
+grep -i "warning" "$TMP/compile.log" && fail "the examples compile with warnings"
+EXB="$TMP/examples/build"
+for p in example_matte example_delta example_bsdfpath; do
+  [ -f "$EXB/$p.so" ] || fail "$p.so was not built"
+  nm -D --defined-only "$EXB/$p.so" | grep -q murk_plugin_entry || fail "$p.so does not export murk_plugin_entry"
+  nm -D --undefined-only "$EXB/$p.so" | grep -q 'murk' && fail "$p.so needs a symbol from libmurk"
+  readelf -d "$EXB/$p.so" | grep -q 'libmurk' && fail "$p.so links libmurk"
+done
+
+export MURK_PLUGIN_PATH="$EXB:$BUILTINS"
+unset LD_LIBRARY_PATH || true
+
+step "murk plugins lists the examples"
+"$MURK" plugins >"$TMP/plugins.txt" || { cat "$TMP/plugins.txt"; fail "murk plugins"; }
+cat "$TMP/plugins.txt"
+for p in example_matte example_delta example_bsdfpath; do
+  grep -q "$p" "$TMP/plugins.txt" || fail "murk plugins does not list $p"
+done
+"$MURK" plugins example_bsdfpath || fail "murk plugins example_bsdfpath"
+
+step "murk check on each example"
+"$MURK" check --quick "$EXB/example_matte.so" || fail "murk check example_matte"
+"$MURK" check --quick example_delta || fail "murk check example_delta"
+"$MURK" check --quick example_bsdfpath || fail "murk check example_bsdfpath"
+
+step "render a scene that names all three"
+cat >"$TMP/examples.yaml" <<'EOF'
+murk: 1
+render: { resolution: [32, 24], spp: 8, seed: 3 }
+camera: { from: [0, 1, 3.4], at: [0, 0.7, 0], up: [0, 1, 0], fov: 40 }
+integrator: { type: example_bsdfpath, max_depth: 8 }
+background: [0.6, 0.7, 0.9]
+materials:
+  matte: { type: example_matte, color: [0.8, 0.7, 0.5], tint: [1, 0.9, 0.9] }
+media:
+  haze: { type: example_delta, density: { constant: 1 }, sigma_a: 0.05, sigma_s: [0.9, 0.6, 0.3] }
+shapes:
+  - { type: quad, center: [0, 0, 0], u: [2, 0, 0], v: [0, 0, -2], material: matte }
+  - { type: sphere, center: [0, 0.7, 0], radius: 0.5, material: matte, exterior: haze }
+  - { type: box, min: [-1, 0.05, -1], max: [1, 1.5, 1], interior: haze }
+EOF
+"$MURK" render "$TMP/examples.yaml" -o "$TMP/examples.exr" --threads 2 || fail "murk render"
+[ -s "$TMP/examples.exr" ] && [ -s "$TMP/examples.png" ] || fail "murk render wrote no image"
+# example_bsdfpath passes media by; volpath_nee traces example_delta's free flights through the haze
+"$MURK" render "$TMP/examples.yaml" -o "$TMP/examples_vol.exr" --threads 2 --set integrator.type=volpath_nee ||
+  fail "murk render with volpath_nee and example_delta"
+"$MURK" compare "$TMP/examples_vol.exr" "$TMP/examples.exr" || fail "the rendered EXRs do not read back"
+echo "sdk: all steps passed"
