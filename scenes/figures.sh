@@ -1,25 +1,124 @@
 #!/bin/sh
-# Renders the media figures of the reference report into out/figures/: the medium scenes with each
-# tracker, and the control-ratio and majorant variants of cornell_smoke — which in murk must look the
-# same (only noise and time change). Usage: scenes/figures.sh [SPP]   (default 256)
-set -eu
+# figures.sh — regenerates the gallery (docs/gallery.md, docs/gallery/*.png): the five figures of the
+# reference report re-rendered by murk. EXRs, logs and a table of every render's spp, time and relMSE
+# go to out/gallery/ (not committed); the strips with their captions go to docs/gallery/.
+#
+#   scenes/figures.sh [FIGURE ...]      # figures 1..5, default: 2 3 4 5
+#
+#   1  GGX roughness and albedo/specular rows (docs/ggx_*.png; rendered into out/gallery only)
+#   2  Cornell box + bunny: decomposition at control 0 beside delta tracking, and their difference
+#   3  cornell_smoke with decomposition: majorant x1.01, x1.1, x2, x4 and control 0.5, 0.1 (equal spp)
+#   4  the three spectral scenes with naive_spectral, spectral, spectral_mis at equal time
+#   5  the final scene, scenes/axe_room.yaml
+#
+# Every render runs under `nice -n 10` with murk's default thread count. Environment: MURK (the murk
+# executable, default ./build/core/murk), PYTHON (default /usr/bin/python3, needs python3-matplotlib
+# for bench/strip.py). The whole default run takes about 12 minutes on an idle 2-core machine.
+set -euf   # -f: no globbing, the [W,H] in --set values stay literal
 cd "$(dirname "$0")/.."
-SPP=${1:-256}
-MURK=./build/core/murk
-OUT=out/figures
-mkdir -p "$OUT"
-for s in cornell_smoke cornell_bunny spectral_absorption spectral_scattering spectral_extinction; do
-  $MURK render scenes/$s.yaml -o "$OUT/$s.exr" --spp "$SPP"
+MURK=${MURK:-./build/core/murk}
+PYTHON=${PYTHON:-/usr/bin/python3}
+OUT=out/gallery
+DOC=docs/gallery
+RES=256                       # figures 2-4: 256x256
+REF_SPP=512                   # references for relMSE (figures 3, 4): 8x the spp of a 64-spp variant
+mkdir -p "$OUT" "$DOC"
+TABLE=$OUT/results.txt
+[ -f "$TABLE" ] || printf 'image\tspp\tseconds\trelMSE\n' > "$TABLE"
+
+# render NAME SCENE ARGS... : renders $OUT/NAME.exr; leaves "SPP SECONDS" in $OUT/NAME.stats
+render() {
+  name=$1; scene=$2; shift 2
+  echo "== $name: murk render $scene $*"
+  nice -n 10 "$MURK" render "$scene" -o "$OUT/$name.exr" "$@" > "$OUT/$name.log" 2>&1 ||
+    { cat "$OUT/$name.log"; exit 1; }
+  # murk's summary: "NAME.exr, NAME.png: WxH, N spp, T s, ..."
+  sed -n 's/.*: [0-9]*x[0-9]*, \([0-9]*\) spp, \([0-9.]*\) s,.*/\1 \2/p' "$OUT/$name.log" | tail -n 1 \
+    > "$OUT/$name.stats"
+  cat "$OUT/$name.stats"
+}
+
+# relmse NAME REF : relMSE of $OUT/NAME.exr against $OUT/REF.exr, appended to the results table
+relmse() {
+  r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '{print $4}')
+  set -- "$1" "$2" "$r" $(cat "$OUT/$1.stats")
+  printf '%s\t%s\t%s\t%s\n' "$1" "$4" "$5" "$3" >> "$TABLE"
+  printf '%s' "$3"
+}
+
+# caption NAME LABEL [REF] : "LABEL\nN spp, T s[\nrelMSE X]" for bench/strip.py
+caption() {
+  set -- "$1" "$2" "${3:-}" $(cat "$OUT/$1.stats")
+  c="$2\\n$4 spp, $5 s"
+  if [ -n "$3" ]; then c="$c\\nrelMSE $(relmse "$1" "$3")"; fi
+  printf '%s' "$c"
+}
+
+figure1() {
+  for s in ggx_roughness ggx_albedo_specular; do
+    render "$s" "scenes/$s.yaml" --spp 256
+  done
+}
+
+figure2() {
+  S=scenes/cornell_bunny.yaml
+  render bunny_delta $S --spp 128 --set render.resolution=[$RES,$RES] --set media.smoke.type=delta
+  render bunny_control0 $S --spp 128 --set render.resolution=[$RES,$RES] \
+    --set media.smoke.type=decomposition --set media.smoke.control=0
+  "$MURK" compare "$OUT/bunny_control0.exr" "$OUT/bunny_delta.exr" --diff "$OUT/bunny_diff.png" \
+    | tee "$OUT/bunny_diff.txt"
+  rel=$(awk '/^MSE/ {print $4}' "$OUT/bunny_diff.txt")
+  white=$(sed -n 's/.*99th percentile (\(.*\))$/\1/p' "$OUT/bunny_diff.txt")
+  "$PYTHON" bench/strip.py --title "Figure 2: decomposition at control 0 vs delta tracking" "$DOC/fig2_bunny.png" \
+    "$OUT/bunny_control0.png:$(caption bunny_control0 'decomposition, control 0')" \
+    "$OUT/bunny_delta.png:$(caption bunny_delta 'delta tracking')" \
+    "$OUT/bunny_diff.png:|control 0 - delta|, relMSE $rel\\nwhite = $white (99th percentile)"
+}
+
+figure3() {
+  S=scenes/cornell_smoke.yaml
+  R="--set render.resolution=[$RES,$RES]"
+  render smoke_reference $S --spp $REF_SPP $R --set media.smoke.type=delta
+  D="--spp 64 $R --set media.smoke.type=decomposition"
+  render smoke_m1 $S $D
+  for f in 1.01 1.1 2 4; do render "smoke_m$f" $S $D --set media.smoke.majorant_factor=$f; done
+  for c in 0.5 0.1; do render "smoke_c$c" $S $D --set media.smoke.control=$c; done
+  "$PYTHON" bench/strip.py --title "Figure 3: decomposition tracking, looser majorants and lower control (64 spp each)" \
+    "$DOC/fig3_majorant_control.png" \
+    "$OUT/smoke_m1.png:$(caption smoke_m1 'majorant x1, control 1' smoke_reference)" \
+    "$OUT/smoke_m1.01.png:$(caption smoke_m1.01 'majorant x1.01' smoke_reference)" \
+    "$OUT/smoke_m1.1.png:$(caption smoke_m1.1 'majorant x1.1' smoke_reference)" \
+    "$OUT/smoke_m2.png:$(caption smoke_m2 'majorant x2' smoke_reference)" \
+    "$OUT/smoke_m4.png:$(caption smoke_m4 'majorant x4' smoke_reference)" \
+    "$OUT/smoke_c0.5.png:$(caption smoke_c0.5 'control 0.5' smoke_reference)" \
+    "$OUT/smoke_c0.1.png:$(caption smoke_c0.1 'control 0.1' smoke_reference)"
+}
+
+figure4() {
+  T=6                          # seconds per render
+  R="--set render.resolution=[$RES,$RES]"
+  for s in absorption scattering extinction; do
+    S=scenes/spectral_$s.yaml
+    render "${s}_reference" $S --spp $REF_SPP $R --set media.medium.type=spectral_mis
+    for t in naive_spectral spectral spectral_mis; do
+      render "${s}_$t" $S --time $T --spp 1000000 $R --set media.medium.type=$t
+    done
+    "$PYTHON" bench/strip.py --title "Figure 4 ($s): equal time, $T s each" "$DOC/fig4_$s.png" \
+      "$OUT/${s}_naive_spectral.png:$(caption "${s}_naive_spectral" 'naive per-channel' "${s}_reference")" \
+      "$OUT/${s}_spectral.png:$(caption "${s}_spectral" 'spectral tracking' "${s}_reference")" \
+      "$OUT/${s}_spectral_mis.png:$(caption "${s}_spectral_mis" 'spectral MIS' "${s}_reference")"
+  done
+}
+
+figure5() {
+  render axe_room scenes/axe_room.yaml --spp 256
+  cp "$OUT/axe_room.png" "$DOC/axe_room.png"
+}
+
+for fig in ${*:-2 3 4 5}; do   # (not $f: the figure functions use f as their own loop variable)
+  case $fig in
+    1|2|3|4|5) start=$(date +%s); "figure$fig"; echo "figure $fig: $(( $(date +%s) - start )) s wall" | tee -a "$OUT/walltime.txt" ;;
+    *) echo "usage: scenes/figures.sh [FIGURE ...]   (figures 1..5)" >&2; exit 2 ;;
+  esac
 done
-for c in 0 0.1 0.5 1; do   # decomposition control ratio
-  $MURK render scenes/cornell_smoke.yaml -o "$OUT/cornell_smoke_control_$c.exr" --spp "$SPP" \
-    --set media.smoke.type=decomposition --set media.smoke.control=$c
-done
-for f in 1 2 4; do         # looser majorants
-  $MURK render scenes/cornell_smoke.yaml -o "$OUT/cornell_smoke_majorant_$f.exr" --spp "$SPP" \
-    --set media.smoke.majorant_factor=$f
-done
-for t in naive_spectral spectral spectral_mis; do
-  $MURK render scenes/spectral_extinction.yaml -o "$OUT/spectral_extinction_$t.exr" --spp "$SPP" \
-    --set media.medium.type=$t
-done
+echo "results: $TABLE"
