@@ -2,6 +2,7 @@
  * symbol table before the object is even loaded, so no plugin code (not even an ELF constructor) runs
  * before it is checked; then the entry function's descriptor is checked field by field. Every refusal
  * is one line naming the file and the cause. */
+#define _GNU_SOURCE /* dladdr() */
 #include "plugin_loader.h"
 #include "util.h"
 
@@ -13,6 +14,8 @@
 #include <errno.h>
 #include <dlfcn.h>
 #include <elf.h>
+#include <execinfo.h>
+#include <signal.h>
 #include <link.h>
 #include <stdarg.h>
 #include <limits.h>
@@ -211,6 +214,65 @@ done:
     return rc;
 }
 
+/* ---- crash reports ----------------------------------------------------------------------------- *
+ * Every plugin file opened is remembered (path and name, copies never freed, so the signal handler
+ * can read them at any time). On SIGSEGV, SIGBUS, SIGFPE or SIGILL the handler walks the crashing
+ * thread's stack and names the innermost plugin on it — the one whose code was running, or called
+ * what crashed — in one line, then dies of the same signal (exit status 128 + signal). */
+enum { MAX_REMEMBERED = 256 };
+static struct { char *path, *name; } remembered[MAX_REMEMBERED];
+static volatile int nremembered;
+
+static void remember(const char *path, const char *name)
+{
+    if (nremembered < MAX_REMEMBERED) {
+        remembered[nremembered].path = murk_strdup(path);
+        remembered[nremembered].name = murk_strdup(name);
+        nremembered++;
+    }
+}
+
+static void crash_handler(int sig)
+{
+    void *frames[64];
+    int n = backtrace(frames, 64);
+    const char *name = NULL, *path = NULL;
+    for (int i = 0; i < n && !name; i++) {
+        Dl_info di;
+        if (!dladdr(frames[i], &di) || !di.dli_fname)
+            continue;
+        for (int k = 0; k < nremembered; k++)
+            if (strcmp(di.dli_fname, remembered[k].path) == 0) {
+                name = remembered[k].name;
+                path = remembered[k].path;
+                break;
+            }
+    }
+    const char *what = sig == SIGSEGV ? "SIGSEGV" : sig == SIGBUS ? "SIGBUS" : sig == SIGFPE ? "SIGFPE" : "SIGILL";
+    char buf[1200];
+    int len = name ? snprintf(buf, sizeof buf, "murk: crashed (%s) in plugin '%s' (%s)\n", what, name, path)
+                   : snprintf(buf, sizeof buf, "murk: crashed (%s) outside any plugin\n", what);
+    if (len > 0 && write(STDERR_FILENO, buf, (size_t)len) < 0)
+        len = 0;
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+void murk_crash_handler_install(void)
+{
+    void *warm[1];
+    backtrace(warm, 1); /* loads the unwinder now, not inside the handler */
+    static const int sigs[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL};
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = crash_handler;
+        sigemptyset(&sa.sa_mask);
+        sa.sa_flags = SA_RESETHAND;
+        sigaction(sigs[i], &sa, NULL);
+    }
+}
+
 int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
@@ -284,6 +346,7 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
         return -1;
     }
     out->path = murk_strdup(path);
+    remember(path, d->name);
     out->handle = h;
     out->desc = d;
     out->abi = abicopy;

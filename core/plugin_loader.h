@@ -34,5 +34,9 @@ size_t murk_registry_describe(const murk_registry *r, char *buf, size_t len);
 int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, size_t errlen);
 void murk_plugin_close(murk_plugin *p);
 const char *murk_kind_name(int kind);
+/* Installs handlers for SIGSEGV, SIGBUS, SIGFPE and SIGILL that print one line naming the plugin on
+ * the crashing thread's stack ("murk: crashed (SIGSEGV) in plugin 'x' (path)") and then die of the
+ * signal. The murk command installs them first thing. */
+void murk_crash_handler_install(void);
 
 #endif

@@ -420,6 +420,24 @@ static const char *scene_using(const char *name, const char *type, const char *e
     return write_tmp(file, text);
 }
 
+/* A plugin that crashes: one line naming it, death by the signal, no output file. */
+static void test_cli_crash(void **state)
+{
+    (void)state;
+    setenv("MURK_PLUGIN_PATH", fixture_dir(), 1);
+    char exr[1100], want[1400];
+    snprintf(exr, sizeof exr, "%s/crash.exr", tmp_dir());
+    const char *scene = scene_using("cli_crasher", "crasher", "");
+    char *out = NULL;
+    int st = run_murk(&out, "render", scene, "-o", exr, "--spp", "1", "--threads", "2", NULL);
+    if (st != 128 + 11)
+        fail_msg("crasher: exit status %d, expected death by SIGSEGV (139):\n%s", st, out);
+    snprintf(want, sizeof want, "murk: crashed (SIGSEGV) in plugin 'crasher' (%s)\n", fixture("crasher"));
+    assert_contains(out, want);
+    assert_int_equal(access(exr, F_OK), -1);
+    free(out);
+}
+
 static void test_cli_render_fixtures(void **state)
 {
     (void)state;
@@ -602,6 +620,7 @@ int main(void)
         cmocka_unit_test(test_empty_path_entry_not_cwd),
         cmocka_unit_test(test_scene_loads_only_named),
         cmocka_unit_test(test_cli_render_fixtures),
+        cmocka_unit_test(test_cli_crash),
         cmocka_unit_test(test_cli_plugins),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
