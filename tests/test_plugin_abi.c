@@ -438,6 +438,31 @@ static void test_cli_crash(void **state)
     free(out);
 }
 
+/* NaN from a plugin: the material or the integrator that produced it is named. */
+static void test_cli_nan_culprit(void **state)
+{
+    (void)state;
+    setenv("MURK_PLUGIN_PATH", fixture_dir(), 1);
+    char exr[1100];
+    snprintf(exr, sizeof exr, "%s/nan.exr", tmp_dir());
+    const char *scene = scene_using("cli_nan_material", "nan_material", "");
+    char *out = NULL;
+    int st = run_murk(&out, "render", scene, "-o", exr, "--spp", "4", NULL);
+    assert_int_equal(st, 0);
+    assert_contains(out, "material 'grey' returned a non-finite sample: the path was ended there");
+    free(out);
+    murk_image img;
+    assert_int_equal(murk_exr_read(exr, &img, err, sizeof err), 0);
+    assert_string_equal(murk_image_meta(&img, "murk:nonfinite_samples"), "0");
+    murk_image_free(&img);
+    scene = scene_using("cli_nan_integrator", "good_fixture", " }\nintegrator: { type: nan_integrator");
+    st = run_murk(&out, "render", scene, "-o", exr, "--spp", "2", NULL);
+    if (st != 0)
+        fail_msg("nan_integrator render: status %d:\n%s", st, out);
+    assert_contains(out, "integrator 'nan_integrator' returned 128 NaN or infinite samples");
+    free(out);
+}
+
 static void test_cli_render_fixtures(void **state)
 {
     (void)state;
@@ -621,6 +646,7 @@ int main(void)
         cmocka_unit_test(test_scene_loads_only_named),
         cmocka_unit_test(test_cli_render_fixtures),
         cmocka_unit_test(test_cli_crash),
+        cmocka_unit_test(test_cli_nan_culprit),
         cmocka_unit_test(test_cli_plugins),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -190,8 +190,8 @@ static int cmd_render(int argc, char **argv)
     }
     murk_warn_summary();
     if (res.nonfinite)
-        murk_log(MURK_LOG_WARN, "%llu samples were NaN or infinite and were left out of their pixels",
-                 (unsigned long long)res.nonfinite);
+        murk_log(MURK_LOG_WARN, "integrator '%s' returned %llu NaN or infinite samples; they were left out of their "
+                 "pixels", s->integrator_plugin->desc->name, (unsigned long long)res.nonfinite);
     free(png);
     free(res.rgb);
     murk_scene_free(s);
