@@ -23,7 +23,10 @@
  * where the cell holds those voxels' centres. The grid covers exactly the field's box, so no cell
  * reaches outside it (outside, the density is 0 and the DDA reports zero segments).
  *
- * Fields and bound grids are immutable after creation: any number of threads may read them. */
+ * Fields and bound grids are immutable after creation: any number of threads may read them.
+ *
+ * Files (core/media): field.c the field itself; vol.c, nanovdb.c and cloud.c its sources; majorant.c
+ * the bound grid; dda.c the walk through it. field_impl.h is what they share. */
 #ifndef MURK_DENSITY_H
 #define MURK_DENSITY_H
 
