@@ -346,6 +346,7 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
         return -1;
     }
     out->path = murk_strdup(path);
+    out->version = MURK_HAS(d->struct_size, murk_plugin_desc, version) ? d->version : NULL;
     remember(path, d->name);
     out->handle = h;
     out->desc = d;
@@ -385,8 +386,8 @@ size_t murk_registry_describe(const murk_registry *r, char *buf, size_t len)
         buf[0] = 0;
     for (size_t i = 0; i < r->nloaded && k < len; i++) {
         const murk_plugin *p = r->loaded[i];
-        int n = snprintf(buf + k, len - k, "%s%s=%s (ABI %u.%u)", i ? "; " : "", p->desc->name, p->path, p->abi.major,
-                         p->abi.minor);
+        int n = snprintf(buf + k, len - k, "%s%s=%s (version %s, ABI %u.%u)", i ? "; " : "", p->desc->name, p->path,
+                         p->version ? p->version : "none", p->abi.major, p->abi.minor);
         if (n < 0)
             break;
         k += (size_t)n;

@@ -10,6 +10,7 @@ typedef struct murk_plugin {
     void *handle;
     const murk_plugin_desc *desc;
     murk_abi abi;
+    const char *version; /* desc->version if the plugin's ABI has it (1.1), else NULL */
 } murk_plugin;
 
 typedef struct murk_registry {
@@ -27,7 +28,7 @@ void murk_registry_free(murk_registry *r); /* dlcloses everything it opened */
 /* Finds NAME.so on the search path, opens and validates it (cached: a name is loaded once).
  * kind 0 accepts any kind. Returns NULL with err = one line naming the file and the cause. */
 const murk_plugin *murk_registry_load(murk_registry *r, int kind, const char *name, char *err, size_t errlen);
-/* Writes "name=path (ABI M.m); ..." for every plugin loaded so far (for the EXR metadata); returns the
+/* Writes "name=path (version V, ABI M.m); ..." for every plugin loaded so far (for the EXR metadata); returns the
  * length it needed (output truncated to len - 1 characters). */
 size_t murk_registry_describe(const murk_registry *r, char *buf, size_t len);
 /* Opens and validates one file. Returns 0, or -1 with err. */

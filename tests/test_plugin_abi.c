@@ -92,8 +92,8 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case bad_cases[] = {
-    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.0"},
-    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.1, this murk has ABI 1.0"},
+    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.1"},
+    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.2, this murk has ABI 1.1"},
     {"no_entry", MURK_KIND_MATERIAL, "no 'murk_plugin_entry' function"},
     {"no_abi", MURK_KIND_MATERIAL, "no 'murk_plugin_abi' symbol: not a murk plugin"},
     {"bad_size", MURK_KIND_MATERIAL, "descriptor struct_size is"},
@@ -135,7 +135,7 @@ static void test_open_bad_details(void **state)
     murk_plugin p;
     char want[256];
     assert_int_equal(murk_plugin_open(fixture("bad_size"), 0, &p, err, sizeof err), -1);
-    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.0",
+    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.1",
              MURK_PLUGIN_DESC_SIZE_1_0 - sizeof(void *), MURK_PLUGIN_DESC_SIZE_1_0);
     assert_contains(err, want);
 
@@ -195,7 +195,7 @@ static void test_open_not_a_library(void **state)
     /* another major ABI with an aborting constructor: refused from the symbol table, never loaded */
     const char *ctor = fixture("abi_ctor");
     assert_int_equal(murk_plugin_open(ctor, 0, &p, err, sizeof err), -1);
-    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.0");
+    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.1");
     assert_null(strchr(err, '\n'));
 }
 
@@ -463,6 +463,40 @@ static void test_cli_nan_culprit(void **state)
     free(out);
 }
 
+/* A plugin built against the ABI 1.0 headers (a smaller descriptor) loads in this 1.1 host and
+ * renders; murk's own plugins carry their version (1.1's appended field). */
+static void test_old_minor(void **state)
+{
+    (void)state;
+    murk_plugin p;
+    assert_int_equal(murk_plugin_open(fixture("old_minor"), MURK_KIND_MATERIAL, &p, err, sizeof err), 0);
+    assert_int_equal(p.abi.major, 1);
+    assert_int_equal(p.abi.minor, 0);
+    assert_int_equal(p.desc->struct_size, MURK_PLUGIN_DESC_SIZE_1_0);
+    assert_null(p.version);
+    murk_plugin_close(&p);
+    assert_int_equal(murk_plugin_open(build_path("plugins/diffuse.so"), MURK_KIND_MATERIAL, &p, err, sizeof err), 0);
+    assert_non_null(p.version);
+    assert_string_equal(p.version, MURK_VERSION_FOR_TESTS);
+    murk_plugin_close(&p);
+
+    setenv("MURK_PLUGIN_PATH", fixture_dir(), 1);
+    char exr[1100];
+    snprintf(exr, sizeof exr, "%s/old_minor.exr", tmp_dir());
+    const char *scene = scene_using("cli_old_minor", "old_minor", "");
+    char *out = NULL;
+    int st = run_murk(&out, "render", scene, "-o", exr, "--spp", "1", "--quiet", NULL);
+    if (st != 0)
+        fail_msg("old_minor render: status %d:\n%s", st, out);
+    free(out);
+    murk_image img;
+    assert_int_equal(murk_exr_read(exr, &img, err, sizeof err), 0);
+    char rec[1300];
+    snprintf(rec, sizeof rec, "old_minor=%s (version none, ABI 1.0)", fixture("old_minor"));
+    assert_contains(murk_image_meta(&img, "murk:plugins"), rec);
+    murk_image_free(&img);
+}
+
 static void test_cli_render_fixtures(void **state)
 {
     (void)state;
@@ -521,7 +555,7 @@ static void test_cli_render_fixtures(void **state)
     const char *plugins = murk_image_meta(&img, "murk:plugins");
     assert_non_null(plugins);
     char rec[1300];
-    snprintf(rec, sizeof rec, "good_fixture=%s (ABI 1.0)", fixture("good_fixture"));
+    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1.1)", fixture("good_fixture"));
     assert_contains(plugins, rec);
     assert_contains(plugins, "path=");
     murk_image_free(&img);
@@ -622,7 +656,7 @@ static void test_cli_plugins(void **state)
     free(out);
     st = run_murk(&out, "plugins", "abi_major", NULL);
     assert_int_equal(st, 1);
-    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.0");
+    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.1");
     assert_contains(out, fixture("abi_major"));
     free(out);
     st = run_murk(&out, "plugins", "good_fixture", NULL);
@@ -646,6 +680,7 @@ int main(void)
         cmocka_unit_test(test_scene_loads_only_named),
         cmocka_unit_test(test_cli_render_fixtures),
         cmocka_unit_test(test_cli_crash),
+        cmocka_unit_test(test_old_minor),
         cmocka_unit_test(test_cli_nan_culprit),
         cmocka_unit_test(test_cli_plugins),
     };

@@ -211,7 +211,7 @@ static const char *type_name(uint32_t t)
 static void describe(const murk_plugin *p)
 {
     const murk_plugin_desc *d = p->desc;
-    printf("%s %s — %s\n  file: %s (ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path,
+    printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path, p->version ? p->version : "none",
            p->abi.major, p->abi.minor);
     if (d->kind == MURK_KIND_MEDIUM)
         printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor, majorant_resolution\n");

@@ -19,7 +19,8 @@
  * vtables and the host table; it never moves, removes or changes the meaning of anything. So a plugin
  * built against ABI 1.m loads in every host 1.n with n >= m: the host reads a descriptor's or
  * vtable's size before touching a field appended after 1.0 (MURK_HAS), and a plugin reads
- * host->size before calling a host service appended after 1.0. Anything else — a changed signature,
+ * host->size before calling a host service appended after 1.0.
+ * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version. Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -41,7 +42,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 0
+#define MURK_ABI_MINOR 1
 
 #if defined(__GNUC__)
 #define MURK_EXPORT __attribute__((visibility("default")))
@@ -188,6 +189,9 @@ typedef struct murk_plugin_desc {
     const murk_param *params;
     uint32_t nparams;
     const void *vtable;   /* murk_material_vt / murk_medium_vt / murk_integrator_vt */
+    /* ABI 1.1 */
+    const char *version;  /* the plugin's own version ("2.3.0"), NULL if none: shown by `murk plugins`
+                           * and recorded in every image it renders */
 } murk_plugin_desc;
 
 /* Every vtable starts with these two fields. */
@@ -196,10 +200,10 @@ typedef struct murk_vt_head {
     uint32_t kind; /* murk_kind: must equal the descriptor's */
 } murk_vt_head;
 
-/* 1 if a struct that starts with a size field (descriptor, vtable, host table) is large enough to
- * hold `member`, i.e. the other side was built with a version that has it. */
-#define MURK_HAS(ptr, type, member) \
-    ((size_t)(ptr)->size >= offsetof(type, member) + sizeof(((const type *)0)->member))
+/* 1 if a struct of `size` bytes (its size field: desc->struct_size, vt->size, host->size) is large
+ * enough to hold `member`, i.e. the other side was built with a version that has it. */
+#define MURK_HAS(size, type, member) \
+    ((size_t)(size) >= offsetof(type, member) + sizeof(((const type *)0)->member))
 #define MURK_PLUGIN_DESC_SIZE_1_0 (offsetof(murk_plugin_desc, vtable) + sizeof(const void *))
 
 #define MURK_PLUGIN_ENTRY_SYMBOL "murk_plugin_entry"
@@ -217,9 +221,12 @@ typedef struct murk_vt_head {
  * The vtable's type is checked at compile time (a material vtable under MURK_MEDIUM_PLUGIN does not
  * compile). params may be NULL with nparams 0. The kind's header (murk/material.h, murk/medium.h or
  * murk/integrator.h) defines the macro. */
+#ifndef MURK_PLUGIN_VERSION
+#define MURK_PLUGIN_VERSION NULL /* define it (e.g. -DMURK_PLUGIN_VERSION='"1.2.0"') to version a plugin */
+#endif
 #define MURK_DEFINE_PLUGIN_(KIND, NAME, DESCRIPTION, PARAMS, NPARAMS, VT)                                      \
     static const murk_plugin_desc murk_plugin_desc_ = {sizeof(murk_plugin_desc), (KIND), (NAME), (DESCRIPTION), \
-                                                       (PARAMS), (NPARAMS), (VT)};                              \
+                                                       (PARAMS), (NPARAMS), (VT), MURK_PLUGIN_VERSION};         \
     MURK_PLUGIN(&murk_plugin_desc_)
 
 #endif
