@@ -1,7 +1,11 @@
 /* embree_throughput — raw Embree rtcIntersect1 rays/s against murk's path-tracing rays/s on the same
- * scene, measured in one run on one thread each, and their ratio.
+ * scene, on one thread each, and their ratio.
  *
- *   build/bench/embree_throughput [scene.yaml] [seconds-per-side]
+ *   build/bench/embree_throughput [scene.yaml] [seconds-per-side-per-round] [rounds]
+ *
+ * The machine's speed drifts (shared, turbo, neighbours), so the two sides are measured in several
+ * short interleaved rounds — raw then murk, murk then raw, ... — each round gives one ratio, and the
+ * median ratio is quoted with its spread (min and max over the rounds). Defaults: 1 s, 9 rounds.
  *
  * The raw side traces random incoherent rays (origins uniform in the scene's bounding box, directions
  * uniform on the sphere) with no shading at all; the murk side is `murk render` with the scene's
@@ -50,29 +54,64 @@ static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
     return (double)n / traced + 0 * (double)hits;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* murk's rays/s over one time-limited render of the scene. */
+static double murk_side(murk_scene *s, double seconds, int *spp)
+{
+    murk_render_opts o = {.threads = 1, .time_limit = seconds};
+    murk_render_result r;
+    murk_render(s, &o, &r);
+    double rps = (double)r.rays / r.seconds;
+    *spp = r.spp;
+    free(r.rgb);
+    return rps;
+}
+
 int main(int argc, char **argv)
 {
     const char *path = argc > 1 ? argv[1] : MURK_SOURCE_ROOT "/scenes/cornell.yaml";
-    double seconds = argc > 2 ? atof(argv[2]) : 5.0;
+    double seconds = argc > 2 ? atof(argv[2]) : 1.0;
+    int rounds = argc > 3 ? atoi(argv[3]) : 9;
+    if (!(seconds > 0.0) || rounds < 1 || rounds > 1000) {
+        fprintf(stderr, "usage: embree_throughput [scene.yaml] [seconds > 0] [rounds 1..1000]\n");
+        return 2;
+    }
+    /* a low resolution keeps murk's passes short, so its time limit is met closely */
+    static const char *const sets[] = {"render.resolution=[128, 128]"};
     char err[1024];
-    murk_scene *s = murk_scene_load(path, NULL, 0, err, sizeof err);
+    murk_scene *s = murk_scene_load(path, sets, 1, err, sizeof err);
     if (!s) {
         fprintf(stderr, "%s\n", err);
         return 1;
     }
-    uint64_t nraw;
-    double raw = raw_embree(s, seconds, &nraw);
-    murk_render_opts o = {.threads = 1, .time_limit = seconds};
-    murk_render_result r;
-    murk_render(s, &o, &r);
-    double murk_rps = (double)r.rays / r.seconds;
-    printf("scene %s, one thread each\n", path);
-    printf("raw Embree rtcIntersect1, random incoherent rays: %.2f Mrays/s (%llu rays)\n", raw / 1e6,
-           (unsigned long long)nraw);
-    printf("murk %s integrator, full render:                %.2f Mrays/s (%llu rays, %d spp, %.1f s)\n",
-           s->integrator_plugin->desc->name, murk_rps / 1e6, (unsigned long long)r.rays, r.spp, r.seconds);
-    printf("ratio murk / raw Embree: %.1f %%\n", 100.0 * murk_rps / raw);
-    free(r.rgb);
+    printf("scene %s (128x128), one thread each, %d rounds of %.1f s per side, order alternating\n", path, rounds,
+           seconds);
+    printf("round  raw Mrays/s  murk Mrays/s  murk/raw\n");
+    double *ratio = murk_xmalloc((size_t)rounds * sizeof *ratio);
+    for (int k = 0; k < rounds; k++) {
+        uint64_t nraw;
+        int spp;
+        double raw, mr;
+        if (k % 2 == 0) {
+            raw = raw_embree(s, seconds, &nraw);
+            mr = murk_side(s, seconds, &spp);
+        } else {
+            mr = murk_side(s, seconds, &spp);
+            raw = raw_embree(s, seconds, &nraw);
+        }
+        ratio[k] = mr / raw;
+        printf("%5d  %11.2f  %12.2f  %7.1f %%\n", k + 1, raw / 1e6, mr / 1e6, 100.0 * ratio[k]);
+    }
+    qsort(ratio, (size_t)rounds, sizeof *ratio, cmp_double);
+    double median = rounds % 2 ? ratio[rounds / 2] : 0.5 * (ratio[rounds / 2 - 1] + ratio[rounds / 2]);
+    printf("murk / raw Embree (%s integrator): median %.1f %%, spread %.1f .. %.1f %%\n",
+           s->integrator_plugin->desc->name, 100.0 * median, 100.0 * ratio[0], 100.0 * ratio[rounds - 1]);
+    free(ratio);
     murk_scene_free(s);
     return 0;
 }
