@@ -1,5 +1,5 @@
-/* image.h — image files: linear float EXR through OpenEXRCore, 8-bit sRGB PNG through libpng.
- * Internal to libmurk. Pixels are interleaved RGB floats, row-major, row 0 at the top.
+/* image.h — image files: linear float EXR through OpenEXRCore (exr.c), 8-bit sRGB PNG through libpng
+ * (png.c), and what they share (image.c). Internal to libmurk. Pixels are interleaved RGB floats, row-major, row 0 at the top.
  * Writers write PATH.tmp-PID and rename it over PATH only when the whole file is written, so a failed
  * or interrupted run never leaves a half-written image. Every function returns 0 on success, or -1
  * with a one-line message in err ("path: what is wrong"). */
@@ -25,6 +25,8 @@ int murk_png_write(const char *path, const float *rgb, int w, int h, float expos
 /* Decodes 8/16-bit grey/RGB/RGBA/palette PNGs; sRGB-encoded values are converted to linear when srgb=1. */
 int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen);
 const char *murk_image_meta(const murk_image *img, const char *key); /* NULL if absent */
+/* 1 if w x h is positive and 3*w*h floats (and 12*w bytes per row) can be addressed. */
+int murk_image_size_ok(long long w, long long h);
 void murk_image_free(murk_image *img);
 
 #endif
