@@ -1,6 +1,7 @@
 /* testutil.c — see testutil.h */
 #include "testutil.h"
 #include "image.h"
+#include "sphere.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -115,90 +116,10 @@ int run_murk_argv(char **out, const char *const *args)
     return WEXITSTATUS(status);
 }
 
-/* Regularised upper incomplete gamma Q(a, x) (Numerical Recipes: series / continued fraction). */
-static double gamma_q(double a, double x)
-{
-    if (x <= 0.0)
-        return 1.0;
-    double gln = lgamma(a);
-    if (x < a + 1.0) {
-        double ap = a, sum = 1.0 / a, del = sum;
-        for (int n = 0; n < 10000; n++) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if (fabs(del) < fabs(sum) * 1e-15)
-                break;
-        }
-        return 1.0 - sum * exp(-x + a * log(x) - gln);
-    }
-    double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
-    for (int i = 1; i < 10000; i++) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < 1e-300)
-            d = 1e-300;
-        c = b + an / c;
-        if (fabs(c) < 1e-300)
-            c = 1e-300;
-        d = 1.0 / d;
-        double del = d * c;
-        h *= del;
-        if (fabs(del - 1.0) < 1e-15)
-            break;
-    }
-    return exp(-x + a * log(x) - gln) * h;
-}
-
-typedef struct { double obs, exp; } bin;
-static int cmp_bin(const void *a, const void *b)
-{
-    double x = ((const bin *)a)->exp, y = ((const bin *)b)->exp;
-    return (x > y) - (x < y);
-}
-
+/* The same chi-square test as `murk check` (core/check/sphere.c). */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out)
 {
-    bin *b = malloc(sizeof *b * (size_t)nbins);
-    for (int i = 0; i < nbins; i++) {
-        b[i].obs = observed[i];
-        b[i].exp = expected[i];
-    }
-    qsort(b, (size_t)nbins, sizeof *b, cmp_bin);
-    double chsq = 0.0, pool_obs = 0.0, pool_exp = 0.0;
-    int cells = 0;
-    for (int i = 0; i < nbins; i++) {
-        if (b[i].exp == 0.0) {
-            if (b[i].obs > 0.0) { /* a sample where the pdf says none can fall */
-                free(b);
-                if (dof_out)
-                    *dof_out = 0;
-                return 0.0;
-            }
-            continue;
-        }
-        pool_obs += b[i].obs;
-        pool_exp += b[i].exp;
-        if (pool_exp >= min_expected) {
-            double d = pool_obs - pool_exp;
-            chsq += d * d / pool_exp;
-            cells++;
-            pool_obs = pool_exp = 0.0;
-        }
-    }
-    if (pool_exp > 0.0) { /* leftover low-expectation mass joins the last cell */
-        double d = pool_obs - pool_exp;
-        chsq += d * d / (pool_exp > 0 ? pool_exp : 1.0);
-        cells++;
-    }
-    free(b);
-    int dof = cells - 1;
-    if (dof_out)
-        *dof_out = dof;
-    if (dof < 1)
-        return 1.0;
-    return gamma_q(dof / 2.0, chsq / 2.0);
+    return murk_chi2_test(observed, expected, nbins, min_expected, dof_out);
 }
 
 /* ---- image stacks -------------------------------------------------------------------------- */
