@@ -17,6 +17,8 @@
 #include "media.h"
 #include "density.h"
 #include "host.h"
+#include "params.h"
+#include "scene.h"
 #include "util.h"
 #include "yread.h"
 

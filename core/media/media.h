@@ -4,7 +4,8 @@
 #define MURK_MEDIA_H
 
 #include "murk/medium.h"
-#include "scene.h"
+#include "murk/murk.h"
+#include "yamldoc.h"
 
 int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
 void murk_media_free(murk_scene *s);

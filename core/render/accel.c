@@ -1,6 +1,6 @@
 /* accel.c — the Embree 3 scene: triangle geometry for quads, boxes and meshes; Embree's analytic
  * point-spheres for spheres. Geometry ids equal shape indices. */
-#include "scene.h"
+#include "accel.h"
 #include "error.h"
 #include "util.h"
 

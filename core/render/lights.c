@@ -2,7 +2,7 @@
  * proportion to its power (luminance x area), sampled uniformly by area (triangles) or uniformly in
  * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
  * normal only; spheres emit outwards. */
-#include "scene.h"
+#include "accel.h"
 #include "util.h"
 
 #include <stdlib.h>

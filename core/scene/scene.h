@@ -1,4 +1,5 @@
-/* scene.h — the scene as the core holds it after loading and validation. Internal to libmurk. */
+/* scene.h — the scene as the core holds it after loading and validation (load.c loads it, scene.c frees
+ * it). Internal to libmurk. */
 #ifndef MURK_SCENE_H
 #define MURK_SCENE_H
 
@@ -87,17 +88,7 @@ struct murk_scene {
     RTCScene rtc;
 };
 
-
-/* Shared by the blocks that instantiate plugins (scene.c, media.c): parameter arrays kept for the
- * scene's lifetime, and schema-checked reading of a plugin block's keys (those in skip[] excepted). */
-murk_value *murk_scene_keep_params(murk_scene *s, size_t n);
-int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
-                                  const char *const *skip, size_t nskip, murk_value *values, char *err,
-                                  size_t errlen);
-
-/* accel.c */
-int murk_accel_build(murk_scene *s, char *err, size_t errlen);
-/* lights.c */
-void murk_lights_build(murk_scene *s);
+/* Releases what a shape owns (its triangle arrays). */
+void murk_shape_free(murk_shape *sh);
 
 #endif

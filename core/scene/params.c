@@ -1,0 +1,140 @@
+/* params.c — plugin parameter blocks: reading a plugin's keys from the scene against the plugin's
+ * schema (types, ranges, choices, textures, required keys), for the scene loader (load.c) and the
+ * media loader (media.c). */
+#include "params.h"
+#include "scene.h"
+#include "texture.h"
+#include "util.h"
+#include "yread.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define ERR(node, ...) murk_yerr(err, errlen, (node), __VA_ARGS__)
+
+murk_value *murk_scene_keep_params(murk_scene *s, size_t n)
+{
+    murk_value *v = murk_xmalloc((n ? n : 1) * sizeof *v);
+    s->param_store = murk_xrealloc(s->param_store, (s->nparam_store + 1) * sizeof *s->param_store);
+    s->param_store[s->nparam_store++] = v;
+    return v;
+}
+
+static int choice_index(const char *choices, const char *word)
+{
+    int idx = 0;
+    size_t wl = strlen(word);
+    for (const char *c = choices;; idx++) {
+        const char *bar = strchr(c, '|');
+        size_t len = bar ? (size_t)(bar - c) : strlen(c);
+        if (len == wl && strncmp(c, word, len) == 0)
+            return idx;
+        if (!bar)
+            return -1;
+        c = bar + 1;
+    }
+}
+
+/* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
+ * block in messages, e.g. "material 'metal' (ggx)". */
+int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
+                                  const char *const *skip, size_t nskip, murk_value *values, char *err, size_t errlen)
+{
+    for (uint32_t i = 0; i < d->nparams; i++) {
+        const murk_param *p = &d->params[i];
+        murk_value *v = &values[i];
+        memset(v, 0, sizeof *v);
+        memcpy(v->f, p->def, sizeof v->f);
+        v->s = p->def_str;
+        if (p->type == MURK_PARAM_ENUM)
+            v->choice = choice_index(p->choices, p->def_str);
+    }
+    for (size_t k = 0; k < map->n; k++) {
+        const char *key = map->keys[k];
+        int skipped = 0;
+        for (size_t j = 0; j < nskip && !skipped; j++)
+            skipped = strcmp(skip[j], key) == 0;
+        if (skipped)
+            continue;
+        int idx = -1;
+        for (uint32_t i = 0; i < d->nparams; i++)
+            if (strcmp(d->params[i].name, key) == 0)
+                idx = (int)i;
+        if (idx < 0) {
+            const char *cand[96];
+            size_t nc = 0;
+            for (uint32_t i = 0; i < d->nparams && nc < 96; i++)
+                cand[nc++] = d->params[i].name;
+            for (size_t j = 0; j < nskip && nc < 96; j++)
+                cand[nc++] = skip[j];
+            const char *sug = murk_did_you_mean(key, cand, nc);
+            if (sug)
+                return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (did you mean '%s'?)", key, who, sug);
+            return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (see: murk plugins %s)", key, who,
+                                 d->name);
+        }
+        const murk_param *p = &d->params[idx];
+        murk_value *v = &values[idx];
+        const murk_ynode *n = map->items[k];
+        char what[256];
+        snprintf(what, sizeof what, "%s: parameter '%s'", who, key);
+        v->set = 1;
+        long long iv = 0;
+        int bv = 0;
+        switch (p->type) {
+        case MURK_PARAM_FLOAT:
+        case MURK_PARAM_RGB:
+            if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE)) {
+                murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
+                if (!t) { /* name the parameter after the location: "file:l:c: WHO: message" */
+                    char msg[2048];
+                    const char *rest = err;
+                    for (int colons = 0; colons < 3 && (rest = strchr(rest, ':')); colons++)
+                        rest++;
+                    snprintf(msg, sizeof msg, "%.*s %s:%s", rest ? (int)(rest - err) : 0, err, what, rest ? rest : err);
+                    snprintf(err, errlen, "%s", msg);
+                    return -1;
+                }
+                s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
+                s->textures[s->ntextures++] = t;
+                v->tex = t;
+                murk_texture_average(t, v->f);
+            } else if (n->kind == MURK_Y_MAP) {
+                return ERR(n, "%s does not take a texture", what);
+            } else if (p->type == MURK_PARAM_FLOAT) {
+                if (murk_yread_range(n, what, p->min, p->max, &v->f[0], err, errlen))
+                    return -1;
+                v->f[1] = v->f[2] = v->f[0];
+            } else if (murk_yread_rgb(n, what, p->min, p->max, v->f, err, errlen)) {
+                return -1;
+            }
+            break;
+        case MURK_PARAM_INT:
+            if (murk_yread_int(n, what, p->min, p->max, &iv, err, errlen))
+                return -1;
+            v->f[0] = (double)iv;
+            break;
+        case MURK_PARAM_BOOL:
+            if (murk_yread_bool(n, what, &bv, err, errlen))
+                return -1;
+            v->f[0] = bv;
+            break;
+        case MURK_PARAM_STRING:
+            if (murk_yread_string(n, what, &v->s, err, errlen))
+                return -1;
+            break;
+        case MURK_PARAM_ENUM:
+            if (n->kind != MURK_Y_SCALAR || (v->choice = choice_index(p->choices, n->str)) < 0)
+                return ERR(n, "%s must be one of %s, got '%s'", what, p->choices, n->kind == MURK_Y_SCALAR ? n->str : "a list");
+            v->s = n->str;
+            break;
+        default:
+            return ERR(n, "%s has an unknown type", what);
+        }
+    }
+    for (uint32_t i = 0; i < d->nparams; i++)
+        if ((d->params[i].flags & MURK_PARAM_REQUIRED) && !values[i].set)
+            return murk_yerr(err, errlen, map, "%s is missing the required parameter '%s'", who, d->params[i].name);
+    return 0;
+}
