@@ -214,7 +214,9 @@ static void describe(const murk_plugin *p)
     printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path, p->version ? p->version : "none",
            p->abi.major, p->abi.minor);
     if (d->kind == MURK_KIND_MEDIUM)
-        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor, majorant_resolution\n");
+        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor, majorant_resolution, transmittance\n");
+    if (d->kind == MURK_KIND_TRANSMITTANCE)
+        printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name, d->name);
     if (!d->nparams) {
         printf("  no parameters\n");
         return;

@@ -13,6 +13,8 @@
  *       g: 0                        # Henyey-Greenstein asymmetry
  *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (warned)
  *       majorant_resolution: 16     # majorant grid cells along the field's longest axis
+ *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
+ *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
 #include "media.h"
 #include "density.h"
@@ -204,8 +206,34 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
 }
 
 static const char *const core_keys[] = {"type", "density", "sigma_a", "sigma_s", "scale", "g", "majorant_factor",
-                                        "majorant_resolution"};
+                                        "majorant_resolution", "transmittance"};
 #define NCORE (sizeof core_keys / sizeof core_keys[0])
+
+/* `transmittance: NAME` or `transmittance: { type: NAME, key: value, ... }`: the medium's estimator plugin,
+ * its parameters checked against its schema like a tracker's, created on the medium's data. */
+static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, murk_named_medium *nm, char *err,
+                          size_t errlen)
+{
+    static const char *const skip[] = {"type"};
+    const murk_ynode *t = n->kind == MURK_Y_MAP ? murk_ymap_get(n, "type") : n;
+    if (!t || t->kind != MURK_Y_SCALAR || !*t->str)
+        return murk_yerr(err, errlen, t ? t : n, "medium '%s': transmittance must be an estimator's name or "
+                         "{ type: NAME, ... } (murk plugins lists the transmittance kind)", name);
+    char lerr[1024], who[256];
+    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_TRANSMITTANCE, t->str, lerr, sizeof lerr);
+    if (!p)
+        return murk_yerr(err, errlen, t, "medium '%s': transmittance: %s", name, lerr);
+    snprintf(who, sizeof who, "medium '%s' transmittance (%s)", name, t->str);
+    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
+    if (murk_scene_read_plugin_params(s, p->desc, n, who, skip, n->kind == MURK_Y_MAP ? 1 : 0, vals, err, errlen))
+        return -1;
+    const murk_transmittance_vt *vt = p->desc->vtable;
+    char cerr[512] = "";
+    if (vt->create(murk_host_table(), &nm->data, vals, &nm->m.tr_self, cerr, sizeof cerr) != 0)
+        return murk_yerr(err, errlen, n, "%s: %s", who, cerr[0] ? cerr : "create() failed");
+    nm->m.tr_vt = vt;
+    return 0;
+}
 
 static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
                        size_t errlen)
@@ -273,13 +301,16 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     nm->m.name = nm->name;
     nm->m.data = md;
     nm->plugin = p;
-    return 0;
+    const murk_ynode *tn = murk_ymap_get(m, "transmittance");
+    return tn ? load_estimator(s, name, tn, nm, err, errlen) : 0;
 }
 
 static void medium_free(murk_named_medium *nm)
 {
     if (nm->m.vt && nm->m.self)
         nm->m.vt->destroy(nm->m.self);
+    if (nm->m.tr_vt && nm->m.tr_self)
+        nm->m.tr_vt->destroy(nm->m.tr_self);
     if (nm->density) {
         murk_field_free(nm->density->field);
         murk_bound_grid_free(&nm->density->grid);

@@ -121,7 +121,7 @@ murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p,
         if (m) {
             murk_ray seg = r;
             seg.tmax = found ? hit.t : r.tmax;
-            murk_rgb Tm = m->vt->transmittance(m->self, &seg, ctx, rng);
+            murk_rgb Tm = murk_medium_transmittance(m, &seg, ctx, rng);
             if (!finite3(Tm))
                 return murk_rgb1((float)broken(h, "medium", m->name, "transmittance"));
             T = murk_rgb_mul(T, Tm);

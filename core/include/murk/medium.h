@@ -23,7 +23,9 @@
  * once through host->warn_once.
  *
  * transmittance() returns an unbiased per-channel estimate of exp(-int sigma_t) over the segment
- * (ratio tracking or better), used on shadow rays.
+ * (ratio tracking or better), used on shadow rays unless the scene gives the medium a transmittance
+ * estimator plugin (`transmittance: NAME`, murk/transmittance.h); integrators call
+ * murk_medium_transmittance(), which dispatches to whichever applies.
  *
  * Unbiased on coloured media. With chromatic extinction there is no single probability of a real
  * collision: taking one channel's (or the average) sigma_t / majorant and giving the other channels
@@ -98,12 +100,30 @@ typedef struct murk_medium_vt {
     MURK_DEFINE_PLUGIN_(MURK_KIND_MEDIUM, NAME, DESCRIPTION, PARAMS, NPARAMS,                      \
                         _Generic((VT), const murk_medium_vt *: (VT), murk_medium_vt *: (VT)))
 
+typedef struct murk_transmittance_vt murk_transmittance_vt; /* murk/transmittance.h */
+
 /* A medium as the scene holds it. */
 struct murk_medium {
     const murk_medium_vt *vt;
     void *self;
     const char *name;
     const murk_medium_data *data;
+    /* ABI 1.2: the medium's transmittance estimator (the scene's `transmittance:` key); NULL: the
+     * tracker's own transmittance(). Call murk_medium_transmittance(), which picks the right one. */
+    const murk_transmittance_vt *tr_vt;
+    void *tr_self;
 };
+
+#include "murk/transmittance.h"
+
+/* The transmittance estimate of a shadow-ray segment through medium m: its estimator plugin if the
+ * scene chose one, else the tracker's own transmittance(). What integrators call on shadow rays. */
+static inline murk_rgb murk_medium_transmittance(const murk_medium *m, const murk_ray *ray, const murk_path_ctx *ctx,
+                                                 murk_rng *rng)
+{
+    if (m->tr_vt)
+        return m->tr_vt->estimate(m->tr_self, ray, ctx, rng);
+    return m->vt->transmittance(m->self, ray, ctx, rng);
+}
 
 #endif

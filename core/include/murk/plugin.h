@@ -1,7 +1,8 @@
 /* murk/plugin.h — the plugin ABI: version, descriptor, parameter schema, host services.
  *
  * A plugin is a shared object that exports exactly two symbols, both made by one of the typed macros
- * at the end of this file (MURK_MATERIAL_PLUGIN, MURK_MEDIUM_PLUGIN, MURK_INTEGRATOR_PLUGIN):
+ * of the kinds' headers (MURK_MATERIAL_PLUGIN, MURK_MEDIUM_PLUGIN, MURK_INTEGRATOR_PLUGIN,
+ * MURK_TRANSMITTANCE_PLUGIN):
  *
  *     MURK_EXPORT const murk_abi murk_plugin_abi = { MURK_ABI_MAJOR, MURK_ABI_MINOR };
  *     MURK_EXPORT const murk_plugin_desc *murk_plugin_entry(void);
@@ -20,7 +21,9 @@
  * built against ABI 1.m loads in every host 1.n with n >= m: the host reads a descriptor's or
  * vtable's size before touching a field appended after 1.0 (MURK_HAS), and a plugin reads
  * host->size before calling a host service appended after 1.0.
- * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version. Anything else — a changed signature,
+ * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version; 1.2 adds the transmittance
+ * kind and murk_medium's estimator fields; 1.3 appends murk_material_vt.flags (MURK_MATERIAL_ORIENTED:
+ * materials that transmit, murk/material.h) and murk_bsdf_sample.eta. Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -42,7 +45,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 1
+#define MURK_ABI_MINOR 3
 
 #if defined(__GNUC__)
 #define MURK_EXPORT __attribute__((visibility("default")))
@@ -57,7 +60,8 @@ typedef struct murk_abi { uint32_t major, minor; } murk_abi;
 typedef enum murk_kind {
     MURK_KIND_MATERIAL = 1,
     MURK_KIND_MEDIUM = 2,
-    MURK_KIND_INTEGRATOR = 3
+    MURK_KIND_INTEGRATOR = 3,
+    MURK_KIND_TRANSMITTANCE = 4 /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
 } murk_kind;
 
 /* ---- Parameter schema ---------------------------------------------------------------------- */
@@ -188,7 +192,7 @@ typedef struct murk_plugin_desc {
     const char *description; /* one line, shown by `murk plugins` */
     const murk_param *params;
     uint32_t nparams;
-    const void *vtable;   /* murk_material_vt / murk_medium_vt / murk_integrator_vt */
+    const void *vtable;   /* murk_material_vt / murk_medium_vt / murk_integrator_vt / murk_transmittance_vt */
     /* ABI 1.1 */
     const char *version;  /* the plugin's own version ("2.3.0"), NULL if none: shown by `murk plugins`
                            * and recorded in every image it renders */
@@ -219,8 +223,8 @@ typedef struct murk_vt_head {
  *     static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, create, destroy, ...};
  *     MURK_MEDIUM_PLUGIN("mytracker", "one-line description", params, NPARAMS, &vt)
  * The vtable's type is checked at compile time (a material vtable under MURK_MEDIUM_PLUGIN does not
- * compile). params may be NULL with nparams 0. The kind's header (murk/material.h, murk/medium.h or
- * murk/integrator.h) defines the macro. */
+ * compile). params may be NULL with nparams 0. The kind's header (murk/material.h, murk/medium.h,
+ * murk/integrator.h or murk/transmittance.h) defines the macro. */
 #ifndef MURK_PLUGIN_VERSION
 #define MURK_PLUGIN_VERSION NULL /* define it (e.g. -DMURK_PLUGIN_VERSION='"1.2.0"') to version a plugin */
 #endif

@@ -1,7 +1,8 @@
 /* murk/tracking.h — helpers for tracker (medium plugin) authors: the common tracker state, free-flight
  * distances, collision choices that stay unbiased (and bounded) on coloured media and where a
- * majorant fails to bound, the warning for that, and ratio-tracking transmittance over the core's
- * majorant grid. Header-only; include after murk/medium.h.
+ * majorant fails to bound, the warning for that, ratio-tracking transmittance over the core's
+ * majorant grid and a ray-marched density integral over it (murk_march_depth, for transmittance
+ * estimators, murk/transmittance.h). Header-only; include after murk/medium.h.
  *
  * A tracker that walks the majorant grid itself (host->walk_init / walk_next) and reads the density
  * with host->density() needs nothing else from here; these helpers are what murk's own trackers share. */
@@ -198,6 +199,59 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
         }
     }
     return T;
+}
+
+/* Ray-marched integral of the density (not of sigma_t) over (ray->tmin, ray->tmax), walked over the
+ * majorant grid: segments whose majorant is 0 are skipped (no lookups; the walk ends at the field's box,
+ * so infinite rays terminate). Two ways to place the lookups, each with an offset u in [0, 1):
+ *   step > 0        a fixed lattice along the whole ray, t_i = tmin + (i + u) step, each lookup
+ *                   weighted by step (the classic ray march; cell boundaries do not matter);
+ *   depth_step > 0  per majorant segment [ta, tb) of length L and majorant density dmax,
+ *                   n = max(1, ceil(dmax sigma L / depth_step)) equal steps at ta + (i + u) L / n
+ *                   (steps follow the majorant optical depth).
+ * With u uniform (one offset per march, drawn by the caller) either sum is an unbiased estimate of the
+ * integral (jittered ray marching); u = 0.5 is the deterministic midpoint rule (biased by its
+ * quadrature error). At most 2^24 lookups per segment (a larger count is clamped: biased, and absurd).
+ * The loops count integer steps, so they advance however large t is. Returns INFINITY if a segment with
+ * dmax > 0 is infinitely long (an unbounded constant field: infinite optical depth). *lookups (if
+ * non-NULL) is increased by the density lookups made. What unbiased_raymarch and raymarch share. */
+static inline double murk_march_depth(const murk_host *h, const murk_medium_data *d, const murk_ray *ray, float step,
+                                      float depth_step, float sigma, float u, long *lookups)
+{
+    murk_majorant_walk w;
+    h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
+    float ta, tb, dmax, dmin;
+    double D = 0.0;
+    long nl = 0;
+    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
+        if (!(dmax > 0.0f) || !(tb > ta))
+            continue;
+        double L = (double)tb - (double)ta, t0, hstep, acc = 0.0;
+        if (!isfinite(L))
+            return INFINITY;
+        long i0, i1;
+        if (step > 0.0f) { /* lattice points tmin + (i + u) step inside [ta, tb) */
+            hstep = step;
+            t0 = ray->tmin;
+            i0 = (long)fmin(ceil(((double)ta - t0) / hstep - u), 9e18);
+            i1 = (long)fmin(ceil(((double)tb - t0) / hstep - u), 9e18);
+        } else {
+            double n = depth_step > 0.0f ? fmax(1.0, ceil((double)dmax * sigma * L / depth_step)) : 1.0;
+            hstep = L / fmin(n, 16777216.0);
+            t0 = ta;
+            i0 = 0;
+            i1 = (long)fmin(n, 16777216.0);
+        }
+        if (i1 - i0 > 16777216L)
+            i1 = i0 + 16777216L;
+        for (long i = i0; i < i1; i++)
+            acc += h->density(d->density, murk_madd(ray->o, ray->d, (float)(t0 + ((double)i + u) * hstep)));
+        D += acc * hstep;
+        nl += i1 > i0 ? i1 - i0 : 0;
+    }
+    if (lookups)
+        *lookups += nl;
+    return D;
 }
 
 /* The transmittance() of a tracker whose struct starts with a murk_tracker: plain ratio tracking. */
