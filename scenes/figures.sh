@@ -12,7 +12,8 @@
 #   5  the final scene, scenes/axe_room.yaml
 #
 # Every render runs under `nice -n 10` with murk's default thread count. Environment: MURK (the murk
-# executable, default ./build/core/murk), PYTHON (default /usr/bin/python3, needs python3-matplotlib
+# executable, default ./build/core/murk), REUSE=1 (keep renders already in out/gallery and only
+# recompute the comparisons and strips), PYTHON (default /usr/bin/python3, needs python3-matplotlib
 # for bench/strip.py). The whole default run takes about 12 minutes on an idle 2-core machine.
 set -euf   # -f: no globbing, the [W,H] in --set values stay literal
 cd "$(dirname "$0")/.."
@@ -21,7 +22,8 @@ PYTHON=${PYTHON:-/usr/bin/python3}
 OUT=out/gallery
 DOC=docs/gallery
 RES=256                       # figures 2-4: 256x256
-REF_SPP=512                   # references for relMSE (figures 3, 4): 8x the spp of a 64-spp variant
+REF_SPP=512                   # references for relMSE (figures 3, 4): 8x the spp of a 64-spp variant,
+                              # seed 1: independent of the variants' seed-0 samples
 mkdir -p "$OUT" "$DOC"
 TABLE=$OUT/results.txt
 [ -f "$TABLE" ] || printf 'image\tspp\tseconds\trelMSE\n' > "$TABLE"
@@ -29,6 +31,9 @@ TABLE=$OUT/results.txt
 # render NAME SCENE ARGS... : renders $OUT/NAME.exr; leaves "SPP SECONDS" in $OUT/NAME.stats
 render() {
   name=$1; scene=$2; shift 2
+  if [ "${REUSE:-0}" = 1 ] && [ -s "$OUT/$name.stats" ] && [ -f "$OUT/$name.exr" ]; then
+    echo "== $name: reused"; return 0
+  fi
   echo "== $name: murk render $scene $*"
   nice -n 10 "$MURK" render "$scene" -o "$OUT/$name.exr" "$@" > "$OUT/$name.log" 2>&1 ||
     { cat "$OUT/$name.log"; exit 1; }
@@ -78,7 +83,7 @@ figure2() {
 figure3() {
   S=scenes/cornell_smoke.yaml
   R="--set render.resolution=[$RES,$RES]"
-  render smoke_reference $S --spp $REF_SPP $R --set media.smoke.type=delta
+  render smoke_reference $S --spp $REF_SPP $R --set media.smoke.type=delta --set render.seed=1
   D="--spp 64 $R --set media.smoke.type=decomposition"
   render smoke_m1 $S $D
   for f in 1.01 1.1 2 4; do render "smoke_m$f" $S $D --set media.smoke.majorant_factor=$f; done
@@ -99,7 +104,8 @@ figure4() {
   R="--set render.resolution=[$RES,$RES]"
   for s in absorption scattering extinction; do
     S=scenes/spectral_$s.yaml
-    render "${s}_reference" $S --spp $REF_SPP $R --set media.medium.type=spectral_mis
+    render "${s}_reference" $S --spp $REF_SPP $R --set media.medium.type=spectral_mis \
+      --set render.seed=1
     for t in naive_spectral spectral spectral_mis; do
       render "${s}_$t" $S --time $T --spp 1000000 $R --set media.medium.type=$t
     done
