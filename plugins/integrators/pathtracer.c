@@ -149,6 +149,8 @@ typedef struct path {
     float prev_pdf;
     int prev_delta; /* 1 at the camera and after a delta lobe: no light sample competed */
     int depth, crossings;
+    float eta_scale; /* product of eta^2 over transmissions: beta * eta_scale is free of the 1 / eta^2 that
+                      * radiance picks up entering a denser medium (for Russian roulette only) */
 } path;
 
 /* L += beta * le * w / mean(R) */
@@ -157,24 +159,35 @@ static void add_light(path *st, murk_rgb le, float w)
     st->L = murk_rgb_add(st->L, murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R)));
 }
 
-/* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side) or
- * the medium's phase function (mat == NULL). */
+/* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side; the
+ * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside) or the medium's
+ * phase function (mat == NULL). */
 typedef struct vertex {
-    murk_vec3 p, offset_n, wo; /* offset_n: the geometric normal at a surface, zero in a medium */
+    murk_vec3 p, offset_n, wo; /* offset_n: the geometric normal at a surface flipped to wo's side, zero in a medium */
     const murk_material *mat;
     const murk_hit *hit;
     murk_vec3 t, b, n, wo_local;
     float g;
+    const murk_medium *behind; /* the medium on the far side of the surface from wo */
 } vertex;
+
+/* 1 if the shading frame and the geometry agree on the side of the surface wi lies on (wo's side:
+ * reflection; the other: transmission), so no light leaks through a surface because its shading normal
+ * says so. */
+static int vertex_side_ok(const vertex *v, murk_vec3 wi, murk_vec3 wl)
+{
+    float gs = murk_dot(wi, v->offset_n);
+    return gs != 0.0f && (gs > 0.0f) == (wl.z > 0.0f);
+}
 
 /* f |cos| towards the world direction wi (the phase function in a medium). */
 static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
         return murk_rgb1(h->phase_eval(v->g, v->wo, wi));
-    if (murk_dot(wi, v->offset_n) <= 0.0f) /* materials only reflect */
-        return murk_rgb1(0.0f);
     murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
+    if (!vertex_side_ok(v, wi, wl))
+        return murk_rgb1(0.0f);
     return murk_rgb_scale(v->mat->vt->eval(v->mat->self, v->hit, v->wo_local, wl), fabsf(wl.z));
 }
 
@@ -202,8 +215,9 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
     }
     if (murk_rgb_is_black(f))
         return;
-    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls.wi, ls.dist), st->medium, &st->ctx,
-                                rng);
+    /* a light behind a transmitting surface is reached through the medium on that side */
+    const murk_medium *m = v->mat && murk_dot(ls.wi, v->offset_n) < 0.0f ? v->behind : st->medium;
+    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls.wi, ls.dist), m, &st->ctx, rng);
     if (murk_rgb_is_black(T))
         return;
     float pdf = vertex_pdf(h, v, ls.wi);
@@ -276,13 +290,16 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     v.p = hit->p;
     v.wo = wo;
     v.mat = hit->material;
-    v.hit = hit;
+    murk_hit mh = *hit; /* the material's copy: n on wo's side */
+    v.hit = &mh;
     v.offset_n = hit->ng;
     v.n = hit->n;
+    v.behind = murk_dot(hit->ng, wo) >= 0.0f ? hit->interior : hit->exterior; /* the medium beyond the surface */
     if (murk_dot(v.offset_n, wo) < 0.0f) { /* the frame on wo's side: two-sided materials */
         v.offset_n = murk_neg(v.offset_n);
         v.n = murk_neg(v.n);
     }
+    mh.n = v.n;
     murk_basis(v.n, &v.t, &v.b);
     v.wo_local = murk_to_local(wo, v.t, v.b, v.n);
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
@@ -291,13 +308,22 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         sample_light(pt, scene, st, &v, rng);
     float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
     murk_bsdf_sample bs;
-    if (!v.mat->vt->sample(v.mat->self, hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
+    bs.eta = 1.0f; /* a material built before ABI 1.3 does not write it */
+    if (!v.mat->vt->sample(v.mat->self, v.hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
         return 0;
     if (!finite3(bs.f) || !isfinite(bs.pdf) || !isfinite(bs.wi.x + bs.wi.y + bs.wi.z))
         return broken(h, "material", v.mat->name, "sample");
     murk_vec3 wi = murk_from_local(bs.wi, v.t, v.b, v.n);
-    if (murk_dot(wi, v.offset_n) <= 0.0f)
+    if (!vertex_side_ok(&v, wi, bs.wi))
         return 0;
+    if (murk_dot(wi, v.offset_n) < 0.0f) { /* transmitted: into the medium behind the surface */
+        if (++st->crossings > 1000)
+            return 0;
+        if (pt->media)
+            st->medium = v.behind;
+        if (bs.eta > 0.0f && isfinite(bs.eta))
+            st->eta_scale *= bs.eta * bs.eta;
+    }
     st->beta = murk_rgb_mul(st->beta, murk_rgb_scale(bs.f, fabsf(bs.wi.z) / bs.pdf));
     st->prev_p = hit->p;
     st->prev_pdf = bs.pdf;
@@ -318,13 +344,14 @@ static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
     return 1;
 }
 
-/* After rr_depth events a path survives with probability q = max_c |beta_c| / mean(R) (at least 0.05,
- * at most 1) and is divided by it. Returns 0 when the path ends. */
+/* After rr_depth events a path survives with probability q = max_c |beta_c| eta_scale / mean(R) (at
+ * least 0.05, at most 1) and is divided by it (eta_scale: a path inside glass is not culled for the
+ * 1 / eta^2 its radiance weight carries there). Returns 0 when the path ends. */
 static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
 {
     if (st->depth > pt->rr_depth) {
         murk_rgb b = st->beta;
-        float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) / mean3(st->R);
+        float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) * st->eta_scale / mean3(st->R);
         q = murk_maxf(0.05f, murk_minf(1.0f, q));
         if (murk_rng_float(rng) >= q)
             return 0;
@@ -339,6 +366,7 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
     const murk_host *h = pt->host;
     path st = {0};
     st.beta = st.R = murk_rgb1(1.0f);
+    st.eta_scale = 1.0f;
     st.ctx.hero = (int)(murk_rng_float(rng) * 3.0f);
     if (st.ctx.hero > 2)
         st.ctx.hero = 2;

@@ -7,7 +7,18 @@
  *
  * Media are tracked through index-matched boundaries (shapes with no material): crossing against the
  * normal enters `interior`, along it leaves to `exterior`; the camera starts in the scene's camera
- * medium. Materials only reflect, so a surface never changes the medium.
+ * medium. A material that transmits (MURK_MATERIAL_ORIENTED, murk/material.h: dielectric) moves a path
+ * whose sampled direction crosses the surface into the medium on the far side, the same way; total
+ * internal reflection is simply a reflected sample, so the path stays. Other materials only reflect.
+ *
+ * Shadow rays stop at every surface with a material, a refracting one included: light does not reach a
+ * point in a glass by a straight line through the glass (it is bent there). NEE therefore finds no
+ * light behind a dielectric, and that light arrives through BSDF / phase sampling alone: after a smooth
+ * dielectric (a delta lobe) the emission found counts with MIS weight 1, since no light sample could
+ * have produced that path; after a rough one it is weighted against the NEE done at the rough
+ * surface vertex itself. So no light is counted twice and none is lost — the interface does not darken
+ * direct light, it only makes it noisier (volpath_nee inside glass behaves like volpath for light
+ * outside the glass).
  *
  * With nee = 1 every scattering vertex (surface or medium) also samples a light point and estimates
  * the transmittance to it (murk_pt_shadow); the light sample and the BSDF / phase sample are weighted
@@ -42,7 +53,7 @@ void murk_pt_destroy(void *self);
 murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *ray, murk_rng *rng);
 
 /* Transmittance of a shadow ray from p to the point q (on a light): 0 if a surface with a material
- * blocks the way, else the product of the media's transmittance() estimates over the legs between
+ * (reflecting or refracting) blocks the way, else the product of the media's transmittance() estimates over the legs between
  * index-matched boundaries. m: the medium at p (ignored, like every medium, when pt->media = 0).
  * offset_n: the normal to offset a surface point along, or a zero vector for a point in a medium.
  * Every leg is aimed at q itself and stops 1e-4 max(1, |q|_inf) short of it. */

@@ -22,8 +22,8 @@
  * vtable's size before touching a field appended after 1.0 (MURK_HAS), and a plugin reads
  * host->size before calling a host service appended after 1.0.
  * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version; 1.2 adds the transmittance
- * kind and murk_medium's estimator fields; 1.3 appends murk_material_vt.flags (MURK_MATERIAL_ORIENTED:
- * materials that transmit, murk/material.h) and murk_bsdf_sample.eta. Anything else — a changed signature,
+ * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
+ * (the hit a material gets has n on wo's side, murk/material.h). Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -110,7 +110,7 @@ typedef struct murk_hit {
     float t;
     murk_vec3 p;      /* world position */
     murk_vec3 ng;     /* unit geometric normal, as the shape defines it (quad: u x v; sphere: outwards) */
-    murk_vec3 n;      /* unit shading normal, same side as ng */
+    murk_vec3 n;      /* unit shading normal, same side as ng (in the hit a material gets: on wo's side) */
     float u, v;       /* surface parameterisation / texture coordinates */
     const murk_material *material; /* NULL: an index-matched medium boundary, not a surface */
     const murk_medium *interior;   /* medium on the -ng side (NULL: vacuum) */

@@ -1,0 +1,363 @@
+/* dielectric — a smooth or rough (GGX) dielectric interface: glass, water, a liquid's surface. Reflects
+ * and transmits (murk/material.h, "Transmission"): it reads which side wo is on from the hit
+ * (murk_material_wo_inside: the hit's n, flipped to wo's side by the integrator, against the shape's
+ * ng) and works below in its own oriented frame, +z = outside, where wo.z < 0 means wo inside.
+ *
+ * Parameters
+ *   ior        RGB in [1, 4], default 1.5. Index of refraction of the inside (the -ng side: inside a
+ *              sphere or box, behind a quad's u x v) relative to the outside. One number for grey; three
+ *              different numbers give RGB dispersion: each channel refracts with its own index (a
+ *              sample then follows one channel, chosen uniformly, and carries 3x that channel's weight
+ *              and 0 in the others; with roughness the pdf is the average of the channels' pdfs).
+ *   roughness  float in [0, 1], default 0. 0: a smooth interface, two delta lobes (mirror reflection and
+ *              Snell refraction) that eval()/pdf() do not describe and sample() marks delta = 1, so the
+ *              integrators skip light sampling and MIS for it. > 0: GGX microfacet reflection and
+ *              transmission (Walter et al. 2007) with alpha = roughness^2 (clamped to >= 0.001),
+ *              height-correlated Smith masking-shadowing, visible-normal sampling (Dupuy & Benyoub 2023).
+ *   tint       RGB in [0, 1], default 1. Multiplies transmitted light at each crossing (a thin coloured
+ *              film; the colour of a thick body belongs in a medium: `interior:`).
+ *
+ * Model (pbrt-v4's DielectricBxDF, in murk's oriented frame: +z = the shading normal = outside; wo.z < 0
+ * is wo inside). eta = ior per channel; etap = eta_wi / eta_wo (eta when wo is outside and wi inside,
+ * 1 / eta the other way). Fresnel is the exact unpolarised dielectric formula, total internal
+ * reflection included (F = 1 past the critical angle, from inside).
+ *   smooth  R = F(|wo.z|), T = 1 - R; sample() picks reflection with probability R, else refraction;
+ *           f = R / |wi.z| (reflection) and T tint / (etap^2 |wi.z|) (refraction), pdf = R or T, so
+ *           the path weight is exactly 1 (reflection) or tint / etap^2.
+ *   rough   with wm the generalised half vector (wo + etap wi, facing +z):
+ *           reflection   f = D(wm) G2(wo, wi) F(wo.wm) / (4 |wo.z| |wi.z|)
+ *           transmission f = D(wm) G2(wo, wi) (1 - F) tint |wi.wm| |wo.wm| / (|wi.z| |wo.z| (wi.wm + wo.wm / etap)^2) / etap^2
+ *           sampling: a visible normal of wo (the lobe of -wo when wo is inside), then reflection with
+ *           probability F(wo.wm), else refraction through wm; pdf = D_wo(wm) R / (4 |wo.wm|) or
+ *           D_wo(wm) T |wi.wm| / (wi.wm + wo.wm / etap)^2, D_wo(wm) = G1(wo) D(wm) |wo.wm| / |wo.z|.
+ *           Microfacets facing away from wo or wi are discarded (f = pdf = 0); samples that reflect
+ *           through the surface or refract back to wo's side are rejected (sample() returns 0).
+ * Transport mode: radiance. murk's integrators trace from the camera and carry radiance, so a
+ * transmitted f includes (eta_wo / eta_wi)^2 — radiance is compressed into the denser medium. The
+ * reciprocity that holds is eval(wo, wi) / eta_wo^2 = eval(wi, wo) / eta_wi^2. sample() reports
+ * s->eta = etap for a refracted sample (1 for a reflected one). With ior 1 and roughness 0 the surface
+ * is invisible (F = 0, straight through).
+ *
+ * Robustness: |wo.z| or |wi.z| below 1e-9 gives f = 0, pdf = 0 and no sample; every output is finite. */
+#include "murk/material.h"
+
+#include <string.h>
+
+enum { P_IOR, P_ROUGHNESS, P_TINT, P_COUNT };
+
+static const murk_param params[P_COUNT] = {
+    [P_IOR] = {"ior", MURK_PARAM_RGB, 0, {1.5, 1.5, 1.5}, NULL, NULL, 1.0, 4.0,
+               "index of refraction inside relative to outside; three values: RGB dispersion"},
+    [P_ROUGHNESS] = {"roughness", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
+                     "0: smooth (delta lobes); > 0: GGX with alpha = roughness^2 (>= 0.001)"},
+    [P_TINT] = {"tint", MURK_PARAM_RGB, MURK_PARAM_TEXTURABLE, {1.0, 1.0, 1.0}, NULL, NULL, 0.0, 1.0,
+                "multiplies transmitted light at each crossing"},
+};
+
+#define DI_MU_MIN 1e-9f
+#define DI_ALPHA_MIN 1e-3f
+
+typedef struct dielectric {
+    const murk_host *host;
+    murk_value p[P_COUNT];
+    float eta[3];
+    int dispersive; /* the channels' indices differ */
+} dielectric;
+
+typedef struct di_shade {
+    float alpha; /* 0: smooth */
+    murk_rgb tint;
+} di_shade;
+
+static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
+
+static void shade_at(const dielectric *d, const murk_hit *hit, di_shade *sh)
+{
+    float v[3];
+    murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
+    float r = clamp01(v[0]);
+    sh->alpha = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
+    murk_value_eval(d->host, &d->p[P_TINT], hit, v);
+    sh->tint = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
+}
+
+/* Unpolarised Fresnel reflectance for the cosine ci of the incident direction with the normal (negative:
+ * from inside) and the relative index eta (inside / outside). 1 under total internal reflection. */
+static float fresnel(float ci, float eta)
+{
+    ci = ci > 1.0f ? 1.0f : (ci < -1.0f ? -1.0f : ci);
+    if (ci < 0.0f) {
+        eta = 1.0f / eta;
+        ci = -ci;
+    }
+    float s2t = (1.0f - ci * ci) / (eta * eta);
+    if (s2t >= 1.0f)
+        return 1.0f;
+    float ct = sqrtf(1.0f - s2t);
+    float rpa = (eta * ci - ct) / (eta * ci + ct), rpe = (ci - eta * ct) / (ci + eta * ct);
+    return 0.5f * (rpa * rpa + rpe * rpe);
+}
+
+/* Refraction of w (pointing away from the surface) through normal n with relative index eta (the side
+ * n points to is outside). Returns 0 under total internal reflection; *etap = eta_wt / eta_w. */
+static int refract(murk_vec3 w, murk_vec3 n, float eta, float *etap, murk_vec3 *wt)
+{
+    float ci = murk_dot(n, w);
+    if (ci < 0.0f) {
+        eta = 1.0f / eta;
+        ci = -ci;
+        n = murk_neg(n);
+    }
+    float s2t = murk_maxf(0.0f, 1.0f - ci * ci) / (eta * eta);
+    if (s2t >= 1.0f)
+        return 0;
+    float ct = sqrtf(1.0f - s2t);
+    *wt = murk_normalize(murk_add(murk_mul(w, -1.0f / eta), murk_mul(n, ci / eta - ct)));
+    *etap = eta;
+    return 1;
+}
+
+static float ggx_D(murk_vec3 m, float a2)
+{
+    float d = a2 * m.z * m.z + (m.x * m.x + m.y * m.y);
+    return a2 / (MURK_PI * d * d);
+}
+static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); } /* |mu| sqrt(1 + a2 tan^2) */
+/* G2 / (|mu_o| |mu_i|), height-correlated Smith */
+static float g2_over(float muo, float mui, float a2)
+{
+    muo = fabsf(muo);
+    mui = fabsf(mui);
+    return 2.0f / (mui * ggx_R(muo, a2) + muo * ggx_R(mui, a2));
+}
+/* G1(w) / |w.z| */
+static float g1_over(float mu, float a2)
+{
+    mu = fabsf(mu);
+    return 2.0f / (mu + ggx_R(mu, a2));
+}
+
+/* Visible GGX normal for wo with wo.z > 0, spherical caps (Dupuy & Benyoub 2023), as in ggx.c. */
+static murk_vec3 sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
+{
+    murk_vec3 ws = murk_normalize(murk_v3(alpha * wo.x, alpha * wo.y, wo.z));
+    float phi = 2.0f * MURK_PI * u0;
+    float z = (1.0f - u1) * (1.0f + ws.z) - ws.z;
+    float st = sqrtf(clamp01(1.0f - z * z));
+    murk_vec3 hs = murk_v3(st * cosf(phi) + ws.x, st * sinf(phi) + ws.y, z + ws.z);
+    return murk_normalize(murk_v3(alpha * hs.x, alpha * hs.y, murk_maxf(hs.z, 0.0f)));
+}
+
+static int usable(float z) { return fabsf(z) >= DI_MU_MIN; } /* NaN -> 0 */
+
+/* Rough lobes for one index eta: f (without tint) into *f, pdf into *pdf. Returns 0 when both are 0. */
+static int rough_one(float eta, float alpha, murk_vec3 wo, murk_vec3 wi, float *f, float *pdf, int *trans)
+{
+    *f = *pdf = 0.0f;
+    float co = wo.z, ci = wi.z;
+    int reflect = co * ci > 0.0f;
+    float etap = reflect ? 1.0f : (co > 0.0f ? eta : 1.0f / eta);
+    *trans = !reflect;
+    murk_vec3 wm = murk_add(murk_mul(wi, etap), wo);
+    float l2 = murk_dot(wm, wm);
+    if (!(l2 > 1e-12f))
+        return 0;
+    wm = murk_mul(wm, 1.0f / sqrtf(l2));
+    if (wm.z < 0.0f)
+        wm = murk_neg(wm);
+    float dwi = murk_dot(wm, wi), dwo = murk_dot(wm, wo);
+    if (dwi * ci <= 0.0f || dwo * co <= 0.0f)
+        return 0;
+    float a2 = alpha * alpha;
+    float D = ggx_D(wm, a2);
+    /* a transmitted pair's Fresnel from the outside direction's cosine, whichever of wo and wi it is: the
+     * same number as from inside, but without the cancellation in 1 - sin^2 near the critical angle, so
+     * f stays reciprocal to float precision */
+    float F = fresnel(reflect || co > 0.0f ? dwo : dwi, eta);
+    float dwo_pdf = g1_over(co, a2) * D * fabsf(dwo); /* D_wo(wm) */
+    if (reflect) {
+        *f = D * F * 0.25f * g2_over(co, ci, a2);
+        *pdf = dwo_pdf * F / (4.0f * fabsf(dwo));
+    } else {
+        float s = dwi + dwo / etap, den = s * s;
+        if (!(den > 0.0f))
+            return 0;
+        float T = 1.0f - F;
+        *f = D * T * g2_over(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
+        *pdf = dwo_pdf * T * fabsf(dwi) / den;
+    }
+    if (!isfinite(*f) || !isfinite(*pdf)) {
+        *f = *pdf = 0.0f;
+        return 0;
+    }
+    return 1;
+}
+
+/* eval and pdf together: f per channel, pdf averaged over the channels when dispersive. */
+static float rough_eval(const dielectric *d, const di_shade *sh, murk_vec3 wo, murk_vec3 wi, murk_rgb *f)
+{
+    *f = murk_rgb1(0.0f);
+    if (!usable(wo.z) || !usable(wi.z) || !(sh->alpha > 0.0f))
+        return 0.0f;
+    float pdf = 0.0f;
+    int trans = 0;
+    for (int c = 0; c < 3; c++) {
+        if (c > 0 && !d->dispersive) {
+            f->c[c] = f->c[0];
+            continue;
+        }
+        float fc, pc;
+        rough_one(d->eta[c], sh->alpha, wo, wi, &fc, &pc, &trans);
+        f->c[c] = fc;
+        pdf += pc;
+    }
+    if (!d->dispersive)
+        pdf *= 3.0f;
+    if (trans)
+        *f = murk_rgb_mul(*f, sh->tint);
+    return pdf * (1.0f / 3.0f);
+}
+
+/* ---- Plugin interface ---------------------------------------------------------------------- */
+static int di_create(const murk_host *host, const murk_value *p, void **self, char *err, size_t errlen)
+{
+    (void)err;
+    (void)errlen;
+    dielectric *d = host->alloc(sizeof *d);
+    if (!d)
+        return -1;
+    d->host = host;
+    memcpy(d->p, p, sizeof d->p);
+    for (int c = 0; c < 3; c++)
+        d->eta[c] = (float)p[P_IOR].f[c];
+    d->dispersive = d->eta[0] != d->eta[1] || d->eta[1] != d->eta[2];
+    *self = d;
+    return 0;
+}
+
+static void di_destroy(void *self)
+{
+    dielectric *d = self;
+    if (d)
+        d->host->free(d);
+}
+
+/* murk's frame (+z on wo's side) to the oriented one (+z outside) and back: the model is isotropic, so
+ * flipping z is all it takes. */
+static int orient(const murk_hit *hit, murk_vec3 *wo, murk_vec3 *wi)
+{
+    if (!murk_material_wo_inside(hit))
+        return 0;
+    wo->z = -wo->z;
+    if (wi)
+        wi->z = -wi->z;
+    return 1;
+}
+
+static murk_rgb di_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+{
+    orient(hit, &wo, &wi);
+    di_shade sh;
+    shade_at(self, hit, &sh);
+    murk_rgb f;
+    rough_eval(self, &sh, wo, wi, &f);
+    return f;
+}
+
+static float di_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+{
+    orient(hit, &wo, &wi);
+    di_shade sh;
+    shade_at(self, hit, &sh);
+    murk_rgb f;
+    return rough_eval(self, &sh, wo, wi, &f);
+}
+
+static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+                              murk_bsdf_sample *s);
+
+static int di_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+{
+    int in = orient(hit, &wo, NULL);
+    int ok = di_sample_oriented(self, hit, wo, u, s);
+    if (in)
+        s->wi.z = -s->wi.z;
+    return ok;
+}
+
+static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+                              murk_bsdf_sample *s)
+{
+    memset(s, 0, sizeof *s);
+    s->eta = 1.0f;
+    if (!usable(wo.z))
+        return 0;
+    di_shade sh;
+    shade_at(d, hit, &sh);
+    float uc = u[2];
+    int ch = 0;
+    if (d->dispersive) { /* one channel's lobes, chosen uniformly; uc reused for the lobe choice */
+        ch = (int)(uc * 3.0f);
+        ch = ch > 2 ? 2 : ch;
+        uc = uc * 3.0f - (float)ch;
+    }
+    float eta = d->eta[ch];
+    if (!(sh.alpha > 0.0f)) { /* smooth: two delta lobes */
+        float R = fresnel(wo.z, eta), T = 1.0f - R;
+        float w;
+        if (uc < R) {
+            s->wi = murk_v3(-wo.x, -wo.y, wo.z);
+            s->pdf = R;
+            w = R;
+            s->f = murk_rgb1(R / fabsf(s->wi.z));
+        } else {
+            float etap;
+            if (!refract(wo, murk_v3(0, 0, 1), eta, &etap, &s->wi) || !usable(s->wi.z) || s->wi.z * wo.z >= 0.0f)
+                return 0;
+            s->pdf = T;
+            w = T;
+            s->f = murk_rgb_scale(sh.tint, T / (etap * etap * fabsf(s->wi.z)));
+            s->eta = etap;
+        }
+        if (!(w > 0.0f))
+            return 0;
+        if (d->dispersive) { /* channel ch only, weight x3 (chosen with probability 1/3) */
+            for (int c = 0; c < 3; c++)
+                s->f.c[c] = c == ch ? 3.0f * s->f.c[c] : 0.0f;
+        }
+        s->delta = 1;
+        return murk_rgb_finite(s->f) && isfinite(s->pdf);
+    }
+    /* rough: a visible normal of wo (of -wo when wo is inside) */
+    murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
+    murk_vec3 wm = sample_vndf(wv, sh.alpha, u[0], u[1]);
+    float R = fresnel(murk_dot(wo, wm), eta);
+    murk_vec3 wi;
+    if (uc < R) {
+        wi = murk_normalize(murk_sub(murk_mul(wm, 2.0f * murk_dot(wo, wm)), wo));
+        if (wi.z * wo.z <= 0.0f)
+            return 0;
+    } else {
+        float etap;
+        if (!refract(wo, wm, eta, &etap, &wi) || wi.z * wo.z >= 0.0f)
+            return 0;
+        s->eta = etap;
+    }
+    if (!usable(wi.z))
+        return 0;
+    murk_rgb f;
+    float pdf = rough_eval(d, &sh, wo, wi, &f);
+    if (!(pdf > 0.0f) || !isfinite(pdf) || !murk_rgb_finite(f))
+        return 0;
+    s->wi = wi;
+    s->f = f;
+    s->pdf = pdf;
+    return 1;
+}
+
+static const murk_material_vt vt = {
+    sizeof(murk_material_vt), MURK_KIND_MATERIAL, di_create, di_destroy, di_eval, di_pdf, di_sample,
+};
+
+MURK_MATERIAL_PLUGIN("dielectric", "smooth or rough (GGX) dielectric: reflection, refraction, TIR; RGB dispersion",
+                     params, P_COUNT, &vt)
