@@ -1,0 +1,59 @@
+#!/usr/bin/python3
+"""Regenerates docs/results/transmittance.csv and the transmittance_*.png charts of docs/results.md.
+
+    /usr/bin/python3 docs/results/plot.py [BUILD_DIR] [SEGMENTS] [ESTIMATES]   (defaults: build 200 1000)
+
+Runs BUILD_DIR/bench/transmittance (see bench/transmittance.c), keeps its CSV, and draws per scene the
+error of the mean of n estimates, sqrt(bias^2 + var / n) averaged over the channels' MSE, against the
+density lookups (n x lookups per estimate) and against the time (n x time per estimate) it costs.
+A biased estimator's curve flattens at its floor sqrt(bias^2). Debian's python3-matplotlib."""
+import csv
+import os
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+here = os.path.dirname(os.path.abspath(__file__))
+root = os.path.dirname(os.path.dirname(here))
+build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
+nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
+nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
+out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
+                     capture_output=True, text=True).stdout
+with open(os.path.join(here, "transmittance.csv"), "w") as f:
+    f.write(out)
+rows = list(csv.DictReader(out.splitlines()))
+styles = {"ratio": ("k", "-"), "residual_ratio": ("tab:blue", "-"), "track_length": ("tab:gray", "-"),
+          "unbiased_raymarch": ("tab:green", "-"), "power_series": ("tab:purple", "-")}
+for scene in dict.fromkeys(r["scene"] for r in rows):
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    for r in (r for r in rows if r["scene"] == scene):
+        name = r["estimator"]
+        var = sum(float(r["var_" + c]) for c in "rgb") / 3
+        # bias^2 is resolved only down to ~var / ESTIMATES: drawn for the biased baseline, 0 for the
+        # unbiased estimators (whose measured bias^2 is at that noise level; see the CSV)
+        b2 = sum(float(r["bias2_" + c]) for c in "rgb") / 3 if name.startswith("raymarch") else 0.0
+        L, ns = max(float(r["lookups"]), 1e-3), float(r["ns"])
+        n = [2 ** (k / 4) for k in range(0, 4 * 20 + 1)]
+        err = [(b2 + var / k) ** 0.5 for k in n]
+        color, ls = styles.get(name, (None, "--" if name.startswith("raymarch") else ":"))
+        label = name + (" (BIASED)" if name.startswith("raymarch") else "")
+        axes[0].loglog([k * L for k in n], err, color=color, ls=ls, label=label)
+        axes[1].loglog([k * ns * 1e-3 for k in n], err, color=color, ls=ls, label=label)
+    axes[0].set_xlabel("density lookups spent on one segment")
+    axes[1].set_xlabel("time spent on one segment (us, one thread)")
+    for ax in axes:
+        ax.set_ylabel("RMSE of the mean transmittance")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_xlim(1, 1e5)
+    axes[1].set_xlim(0.1, 1e4)
+    axes[1].legend(fontsize=7, loc="lower left")
+    fig.suptitle(f"{scene}: shadow-ray transmittance, error vs cost (bench/transmittance, {nseg} segments x {nest})")
+    fig.tight_layout()
+    fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90)
+    plt.close(fig)
+print(out, end="")
