@@ -18,7 +18,6 @@
 #include "util.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -476,16 +475,11 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
 
 MURK_API int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen)
 {
-    if (!img)
-        return murk_err_file(err, errlen, path ? path : "(null)", "no image to read into");
-    memset(img, 0, sizeof *img);
-    if (!path)
-        return murk_err_file(err, errlen, "(null)", "no path");
     exr_io io;
     memset(&io, 0, sizeof io);
-    io.fd = open(path, O_RDONLY | O_CLOEXEC);
+    io.fd = murk_image_open_input(path, img, err, errlen);
     if (io.fd < 0)
-        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+        return -1;
 
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = exr_read_error_cb;

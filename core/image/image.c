@@ -1,8 +1,11 @@
-/* image.c — what the EXR (exr.c) and PNG (png.c) readers and writers share: size checks, the image
- * returned by the readers and its string attributes. */
+/* image.c — what the EXR (exr.c) and PNG (png.c) readers and writers share: size checks, opening an
+ * input, the image returned by the readers and its string attributes. */
 #include "image.h"
+#include "error.h"
 #include "util.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -13,6 +16,19 @@ int murk_image_size_ok(long long w, long long h)
 {
     return w > 0 && h > 0 && w <= INT_MAX / 12 && h <= INT_MAX &&
            (unsigned long long)w * (unsigned long long)h <= SIZE_MAX / 12;
+}
+
+int murk_image_open_input(const char *path, murk_image *img, char *err, size_t errlen)
+{
+    if (!img)
+        return murk_err_file(err, errlen, path ? path : "(null)", "no image to read into");
+    memset(img, 0, sizeof *img);
+    if (!path)
+        return murk_err_file(err, errlen, "(null)", "no path");
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+    return fd;
 }
 
 const char *murk_image_meta(const murk_image *img, const char *key)

@@ -27,6 +27,8 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
 const char *murk_image_meta(const murk_image *img, const char *key); /* NULL if absent */
 /* 1 if w x h is positive and 3*w*h floats (and 12*w bytes per row) can be addressed. */
 int murk_image_size_ok(long long w, long long h);
+/* What both readers do first: clears img and opens path for reading. The descriptor, or -1 with err set. */
+int murk_image_open_input(const char *path, murk_image *img, char *err, size_t errlen);
 void murk_image_free(murk_image *img);
 
 #endif

@@ -10,8 +10,6 @@
 #include "error.h"
 #include "util.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdio.h>
@@ -159,16 +157,11 @@ static int png_decode(png_job *j)
 
 int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
 {
-    if (!img)
-        return murk_err_file(err, errlen, path ? path : "(null)", "no image to read into");
-    memset(img, 0, sizeof *img);
-    if (!path)
-        return murk_err_file(err, errlen, "(null)", "no path");
     png_job j;
     memset(&j, 0, sizeof j);
-    int rc = 0, fd = open(path, O_RDONLY | O_CLOEXEC);
+    int rc = 0, fd = murk_image_open_input(path, img, err, errlen);
     if (fd < 0)
-        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+        return -1;
     j.fp = fdopen(fd, "rb");
     if (!j.fp) {
         close(fd);
