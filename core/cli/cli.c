@@ -17,6 +17,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,6 +26,7 @@
 static const char usage_text[] =
     "usage:\n"
     "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
+    "              [--checkpoint FILE [--every S]] [--resume FILE]\n"
     "  murk plugins [NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
@@ -88,13 +90,35 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.0f ", v);
 }
 
+/* SIGINT/SIGTERM during `render`: the running pass is abandoned, the image of the whole passes done is
+ * written (murk:interrupted says so) and murk exits with 128 + the signal's number. */
+static volatile sig_atomic_t render_stop, render_signal;
+
+static void on_stop_signal(int sig)
+{
+    render_signal = sig;
+    render_stop = 1;
+}
+
+static void catch_stop_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
 static int cmd_render(int argc, char **argv)
 {
+    catch_stop_signals();
     const char *scene_path = NULL, *out = NULL;
     const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
     size_t nsets = 0;
     murk_render_opts opts = {0};
-    int quiet = 0;
+    opts.checkpoint_every = 60;
+    int quiet = 0, every_given = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -119,6 +143,18 @@ static int cmd_render(int argc, char **argv)
                 return free(sets), 2;
             }
             opts.time_limit = t, i++;
+        } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume")) {
+            if (!v || !*v)
+                return free(sets), usage(a[2] == 'c' ? "--checkpoint needs a file name" : "--resume needs a file name");
+            *(a[2] == 'c' ? &opts.checkpoint : &opts.resume) = v, i++;
+        } else if (!strcmp(a, "--every")) {
+            char *end;
+            double t = v ? strtod(v, &end) : -1;
+            if (!v || *end || !(t >= 0) || !isfinite(t)) {
+                fprintf(stderr, "murk: --every needs a number of seconds >= 0, got '%s'\n", v ? v : "");
+                return free(sets), 2;
+            }
+            opts.checkpoint_every = t, every_given = 1, i++;
         } else if (!strcmp(a, "--set")) {
             if (!v)
                 return free(sets), usage("--set needs KEY.PATH=VALUE");
@@ -139,6 +175,8 @@ static int cmd_render(int argc, char **argv)
     }
     if (!scene_path)
         return free(sets), usage("render needs a scene file");
+    if (every_given && !opts.checkpoint)
+        return free(sets), usage("--every needs --checkpoint");
     char *outbuf = out ? murk_strdup(out) : default_output(scene_path);
     size_t ol = strlen(outbuf);
     if (ol < 5 || strcmp(outbuf + ol - 4, ".exr") != 0) {
@@ -157,30 +195,64 @@ static int cmd_render(int argc, char **argv)
         return 1;
     }
     opts.progress = !quiet && isatty(STDERR_FILENO);
+    char setbuf[4096] = "";
+    for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
+        k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
+    if (opts.checkpoint || opts.resume) {
+        opts.scene_hash = murk_file_hash(scene_path, err, sizeof err);
+        opts.overrides = setbuf;
+        if (!opts.scene_hash) {
+            fprintf(stderr, "%s\n", err);
+            murk_scene_free(s);
+            free(outbuf);
+            free(sets);
+            return 1;
+        }
+    }
+    opts.stop = &render_stop;
     murk_render_result res;
-    murk_render(s, &opts, &res);
+    if (murk_render_err(s, &opts, &res, err, sizeof err) != 0) {
+        fprintf(stderr, "murk: %s\n", err);
+        if (!res.rgb) {
+            murk_scene_free(s);
+            free(outbuf);
+            free(sets);
+            return 1;
+        }
+    }
+    int ck_failed = err[0] != 0;
 
-    char spp[32], seed[32], secs[32], nonfinite[32], setbuf[4096] = "", plugins[4096];
+    char spp[32], seed[32], secs[32], nonfinite[32], plugins[4096], interrupted[96] = "no", spp_asked[32];
     murk_registry_describe(&s->reg, plugins, sizeof plugins);
     snprintf(spp, sizeof spp, "%d", res.spp);
+    snprintf(spp_asked, sizeof spp_asked, "%d", opts.spp > 0 ? opts.spp : s->spp);
+    if (res.interrupted)
+        snprintf(interrupted, sizeof interrupted, "%s after %d of %s spp",
+                 render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked);
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
-    for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
-        k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
+        {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
+        {"murk:resumed_from", opts.resume ? opts.resume : ""},
     };
     char *png = png_path_for(outbuf);
-    int rc = 0;
+    int rc = ck_failed ? 1 : 0;
+    if (res.interrupted)
+        fprintf(stderr, "murk: interrupted (%s): writing the image with %d of %s spp%s%s\n",
+                render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked,
+                opts.checkpoint ? "; resume with --resume " : "", opts.checkpoint ? opts.checkpoint : "");
     if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, (int)(sizeof meta / sizeof meta[0]), err,
                        sizeof err) != 0 ||
         murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0) {
         fprintf(stderr, "murk: %s\n", err);
         rc = 1;
     }
+    if (res.interrupted || render_stop) /* also when the signal came during the writes and cut them short */
+        rc = 128 + (render_signal ? (int)render_signal : SIGINT);
     if (rc == 0 && !quiet) {
         char sps[32], rps[32];
         human((double)res.samples / res.seconds, sps, sizeof sps);

@@ -1,6 +1,8 @@
 /* render.c — tiles over a thread pool. Each (pixel, sample) has its own random stream seeded from
  * (seed, pixel, sample) and each pixel is accumulated by one thread in sample order, so the image is
  * bitwise identical for any thread count. Non-finite samples are counted and left out of the pixel. */
+#include "checkpoint.h"
+#include "error.h"
 #include "host.h"
 #include "scene.h"
 #include "util.h"
@@ -29,6 +31,8 @@ typedef struct job {
     atomic_int next;
     atomic_int done;
     atomic_uint_fast64_t rays, nonfinite;
+    volatile sig_atomic_t *stop; /* set: take no more tiles; the pass is abandoned */
+    atomic_int abandoned;
 } job;
 
 static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
@@ -53,6 +57,11 @@ static void *worker(void *arg)
     murk_host_thread_reset();
     uint64_t bad = 0;
     for (;;) {
+        if (j->stop && *j->stop) {
+            if (atomic_load(&j->next) < j->ntiles)
+                atomic_store(&j->abandoned, 1);
+            break;
+        }
         int t = atomic_fetch_add(&j->next, 1);
         if (t >= j->ntiles)
             break;
@@ -104,6 +113,7 @@ static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_
 {
     atomic_store(&j->next, 0);
     atomic_store(&j->done, 0);
+    atomic_store(&j->abandoned, 0);
     pthread_t *th = murk_xmalloc((size_t)nthreads * sizeof *th);
     int started = 0;
     for (; started < nthreads; started++)
@@ -113,7 +123,7 @@ static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_
         free(th);
         worker(j); /* no threads to be had: render here */
     } else {
-        while (progress && atomic_load(&j->done) < j->ntiles) {
+        while (progress && atomic_load(&j->done) < j->ntiles && !(j->stop && *j->stop)) {
             double frac = ((double)spp_before + (double)(j->spp1 - j->spp0) * atomic_load(&j->done) / j->ntiles) /
                           (double)spp_total;
             progress_bar(frac, murk_now() - t_start);
@@ -127,8 +137,34 @@ static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_
     return 0;
 }
 
+/* Saves the state after `done` whole samples per pixel; 0 or -1 with err set. */
+static int save_checkpoint(const murk_scene *s, const murk_render_opts *opts, const job *j, int done, char *err,
+                           size_t errlen)
+{
+    murk_ckpt c = {.scene_hash = opts->scene_hash, .seed = s->seed, .width = s->width, .height = s->height,
+                   .spp = done, .overrides = opts->overrides ? opts->overrides : "",
+                   .nonfinite = (uint64_t)atomic_load(&j->nonfinite), .rays = (uint64_t)atomic_load(&j->rays),
+                   .sum = j->sum, .count = j->count};
+    return murk_ckpt_save(opts->checkpoint, &c, err, errlen);
+}
+
 MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk_render_result *out)
 {
+    return murk_render_err(s, opts, out, NULL, 0);
+}
+
+/* Passes: with a time limit, stop signal or checkpoint, passes are sized to take about PASS_SECONDS (the
+ * loss when a pass is abandoned, the granularity of checkpoints); otherwise one pass does every sample.
+ * Only whole passes count: a pass abandoned on a stop is rolled back from the copy taken before it. */
+#define PASS_SECONDS 0.5
+
+MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, murk_render_result *out, char *err,
+                             size_t errlen)
+{
+    char errbuf[1024];
+    if (!err || !errlen)
+        err = errbuf, errlen = sizeof errbuf;
+    err[0] = 0;
     memset(out, 0, sizeof *out);
     int spp = opts->spp > 0 ? opts->spp : s->spp;
     int nthreads = opts->threads > 0 ? opts->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
@@ -142,33 +178,96 @@ MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk
     j.count = murk_xmalloc(npix * sizeof(uint32_t));
     j.tiles_x = (s->width + TILE - 1) / TILE;
     j.ntiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
+    j.stop = opts->stop;
     atomic_init(&j.rays, 0);
     atomic_init(&j.nonfinite, 0);
+    atomic_init(&j.abandoned, 0);
 
-    double t0 = murk_now();
-    int done = 0, pass = 1;
-    while (done < spp) {
-        int n = opts->time_limit > 0 ? pass : spp - done;
+    int done = 0, rc = 0;
+    uint64_t rays_before = 0;
+    if (opts->resume) {
+        murk_ckpt want = {.scene_hash = opts->scene_hash, .seed = s->seed, .width = s->width, .height = s->height,
+                          .overrides = opts->overrides}, c;
+        if (murk_ckpt_load(opts->resume, &want, &c, err, errlen) != 0) {
+            free(j.sum);
+            free(j.count);
+            return -1;
+        }
+        if (c.spp > spp) {
+            murk_err_file(err, errlen, opts->resume, "the checkpoint has %d spp, more than the %d asked for", c.spp,
+                          spp);
+            murk_ckpt_free(&c);
+            free(j.sum);
+            free(j.count);
+            return -1;
+        }
+        memcpy(j.sum, c.sum, 3 * npix * sizeof(double));
+        memcpy(j.count, c.count, npix * sizeof(uint32_t));
+        atomic_store(&j.nonfinite, c.nonfinite);
+        atomic_store(&j.rays, c.rays);
+        rays_before = c.rays;
+        done = out->resumed_spp = c.spp;
+        murk_ckpt_free(&c);
+    }
+    int adaptive = opts->time_limit > 0 || opts->stop || opts->checkpoint;
+    double *keep_sum = opts->stop ? murk_xmalloc(3 * npix * sizeof(double)) : NULL;
+    uint32_t *keep_count = opts->stop ? murk_xmalloc(npix * sizeof(uint32_t)) : NULL;
+
+    double t0 = murk_now(), last_ckpt = t0;
+    int pass = 1, start = done;
+    while (done < spp && !(opts->stop && *opts->stop)) {
+        int n = adaptive ? pass : spp - done;
         if (n > spp - done)
             n = spp - done;
         j.spp0 = done;
         j.spp1 = done + n;
+        uint64_t bad_before = (uint64_t)atomic_load(&j.nonfinite);
+        if (keep_sum) {
+            memcpy(keep_sum, j.sum, 3 * npix * sizeof(double));
+            memcpy(keep_count, j.count, npix * sizeof(uint32_t));
+        }
         double tp = murk_now();
-        run_pass(&j, nthreads, opts->progress, t0, spp, done);
+        run_pass(&j, nthreads, opts->progress, t0, spp - start, done - start);
+        if (atomic_load(&j.abandoned)) { /* roll the partial pass back: only whole passes count */
+            memcpy(j.sum, keep_sum, 3 * npix * sizeof(double));
+            memcpy(j.count, keep_count, npix * sizeof(uint32_t));
+            atomic_store(&j.nonfinite, bad_before);
+            break;
+        }
         done += n;
+        double now = murk_now(), per_spp = (now - tp) / n;
+        if (opts->checkpoint && done < spp && now - last_ckpt >= opts->checkpoint_every &&
+            !(opts->stop && *opts->stop)) {
+            if (save_checkpoint(s, opts, &j, done, err, errlen) != 0) {
+                if (opts->stop && *opts->stop) { /* the signal cut the write short: the final save redoes it */
+                    err[0] = 0;
+                    break;
+                }
+                rc = -1;
+                break;
+            }
+            last_ckpt = murk_now();
+        }
         if (opts->time_limit > 0) {
-            double now = murk_now(), per_spp = (now - tp) / n, left = opts->time_limit - (now - t0);
+            double left = opts->time_limit - (now - t0);
             if (left <= per_spp)
                 break;
             pass = (int)(left / per_spp * 0.9); /* next pass fills most of what is left */
-            if (pass < 1)
-                pass = 1;
-            if (pass > 2 * n + 1)
-                pass = 2 * n + 1; /* grow gradually so the estimate can adapt */
+        } else if (adaptive) {
+            pass = (int)(PASS_SECONDS / (per_spp > 1e-9 ? per_spp : 1e-9));
         }
+        if (pass < 1)
+            pass = 1;
+        if (pass > 2 * n + 1)
+            pass = 2 * n + 1; /* grow gradually so the estimate can adapt */
     }
+    out->interrupted = done < spp && opts->stop && *opts->stop;
+    if (rc == 0 && opts->checkpoint && save_checkpoint(s, opts, &j, done, err, errlen) != 0)
+        rc = -1;
+    free(keep_sum);
+    free(keep_count);
     if (opts->progress) {
-        progress_bar((double)done / spp, murk_now() - t0);
+        progress_bar((double)(done - start) / (spp - start > 0 ? spp - start : 1), murk_now() - t0);
         fputc('\n', stderr);
     }
     out->seconds = murk_now() - t0;
@@ -179,10 +278,10 @@ MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk
     for (size_t i = 0; i < npix; i++)
         for (int c = 0; c < 3; c++)
             out->rgb[3 * i + (size_t)c] = j.count[i] ? (float)(j.sum[3 * i + (size_t)c] / j.count[i]) : 0.0f;
-    out->samples = (uint64_t)done * npix;
-    out->rays = atomic_load(&j.rays);
+    out->samples = (uint64_t)(done - start) * npix;
+    out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
     free(j.sum);
     free(j.count);
-    return 0;
+    return rc;
 }

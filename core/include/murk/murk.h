@@ -3,6 +3,7 @@
 #ifndef MURK_MURK_H
 #define MURK_MURK_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -13,19 +14,37 @@ typedef struct murk_render_opts {
     int threads;        /* 0 = all cores */
     double time_limit;  /* seconds; > 0 stops after the last whole pass that fits (spp is then a cap) */
     int progress;       /* draw a progress bar on stderr */
+    /* Interrupt and resume (all optional; zero = off). Whole passes only ever count: the image depends
+     * on (scene, seed, spp) alone, however the render was cut into passes, interrupted and resumed. */
+    volatile sig_atomic_t *stop; /* set (e.g. by a signal handler): abandon the running pass and return
+                                    the spp of the whole passes done, with interrupted = 1 */
+    const char *checkpoint;      /* save the accumulated state here (atomically) after a pass when
+                                    checkpoint_every seconds have passed, and at the end */
+    double checkpoint_every;     /* seconds; 0 = after every pass */
+    const char *resume;          /* continue from this checkpoint (same scene, overrides, seed, size) */
+    uint64_t scene_hash;         /* identify the scene in a checkpoint: its content hash ... */
+    const char *overrides;       /* ... and its --set overrides (NULL = none) */
 } murk_render_opts;
 
 typedef struct murk_render_result {
     int width, height, spp; /* spp actually rendered */
     float *rgb;             /* 3*width*height linear floats, row 0 at the top; free() it */
     double seconds;
-    uint64_t samples, rays, nonfinite;
+    uint64_t samples, rays, nonfinite; /* samples and rays: this run's; nonfinite: the image's (resumed too) */
+    int interrupted;        /* opts->stop was set before spp was reached */
+    int resumed_spp;        /* spp taken from opts->resume */
 } murk_render_result;
 
 /* `sets` are "KEY.PATH=VALUE" overrides. NULL with a one-line "file:line:col: message" in err. */
 murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen);
 void murk_scene_free(murk_scene *scene);
+/* 0, or -1 with a one-line message in err (a checkpoint that cannot be read, is of another scene, or
+ * cannot be written); err may be NULL. */
 int murk_render(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out);
+int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out, char *err,
+                    size_t errlen);
+/* FNV-1a 64 of a file's bytes (a scene's content hash for checkpoints); 0 with err set if unreadable. */
+uint64_t murk_file_hash(const char *path, char *err, size_t errlen);
 /* The `murk` command line (render / plugins / compare / grid); returns the exit status. */
 int murk_cli_main(int argc, char **argv);
 

@@ -1,0 +1,303 @@
+/* test_resume.c — interrupt and resume (issue 10, item 7). Renders are killed with SIGINT or SIGTERM at
+ * random points (during a pass, during a checkpoint or image write, before rendering starts), resumed
+ * from their checkpoint, killed again, ... until they finish; the finished image must be bitwise
+ * identical to an uninterrupted render of the same spp. An interrupted render must exit with 128 + the
+ * signal, write the image of the spp it reached (murk:spp, murk:interrupted) or nothing, and leave no
+ * temporary file behind. A checkpoint of another scene / other overrides is refused. */
+#include "image.h"
+#include "testutil.h"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#define SPP "96"
+
+static const char *scene_path(void) { return src_path("scenes/cornell.yaml"); }
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Starts `murk render` on the small Cornell box into dir/out with extra arguments (NULL-terminated). */
+static pid_t start_render(const char *dir, const char *out, const char *const *extra)
+{
+    const char *exe = getenv("MURK_EXE");
+    assert_non_null(exe);
+    const char *argv[32];
+    int n = 0;
+    argv[n++] = exe;
+    argv[n++] = "render";
+    argv[n++] = scene_path();
+    argv[n++] = "-o";
+    argv[n++] = out;
+    argv[n++] = "--spp";
+    argv[n++] = SPP;
+    argv[n++] = "--threads";
+    argv[n++] = "2";
+    argv[n++] = "--set";
+    argv[n++] = "render.resolution=[48,40]";
+    argv[n++] = "--quiet";
+    for (int i = 0; extra && extra[i]; i++)
+        argv[n++] = extra[i];
+    argv[n] = NULL;
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        if (chdir(dir) != 0)
+            _exit(126);
+        int fd = open("/dev/null", O_WRONLY);
+        if (fd >= 0) {
+            dup2(fd, STDOUT_FILENO);
+            dup2(fd, STDERR_FILENO);
+        }
+        execv(exe, (char *const *)argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+static int wait_status(pid_t pid)
+{
+    int st;
+    assert_int_equal(waitpid(pid, &st, 0), pid);
+    return st;
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    struct stat st;
+    return stat(p, &st) == 0;
+}
+
+static void no_temporaries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (strstr(e->d_name, ".tmp-")) {
+            fprintf(stderr, "temporary left behind: %s/%s\n", dir, e->d_name);
+            fail();
+        }
+    }
+    closedir(d);
+}
+
+static void read_exr(const char *dir, const char *name, murk_image *img)
+{
+    char p[4096], err[1024];
+    snprintf(p, sizeof p, "%s/%s", dir, name);
+    if (murk_exr_read(p, img, err, sizeof err) != 0) {
+        fprintf(stderr, "%s\n", err);
+        fail();
+    }
+}
+
+static const char *make_dir(const char *name)
+{
+    static char buf[4][4096];
+    static int k;
+    char *p = buf[k++ % 4];
+    snprintf(p, 4096, "%s/%s", tmp_dir(), name);
+    mkdir(p, 0777);
+    return p;
+}
+
+static double t_ref; /* seconds an uninterrupted render takes */
+static murk_image ref;
+
+static void render_reference(void)
+{
+    if (ref.rgb)
+        return;
+    const char *dir = make_dir("ref");
+    double t0 = now();
+    assert_int_equal(wait_status(start_render(dir, "ref.exr", NULL)), 0);
+    t_ref = now() - t0;
+    read_exr(dir, "ref.exr", &ref);
+    assert_string_equal(murk_image_meta(&ref, "murk:spp"), SPP);
+    assert_string_equal(murk_image_meta(&ref, "murk:interrupted"), "no");
+    fprintf(stderr, "reference render: %.2f s\n", t_ref);
+}
+
+/* Kills renders at random points and resumes them until one finishes; returns the number of kills that
+ * interrupted a render. */
+static int kill_and_resume(unsigned seed, int round, int *interrupted_images)
+{
+    char name[64];
+    snprintf(name, sizeof name, "round%d", round);
+    const char *dir = make_dir(name);
+    srand(seed);
+    int kills = 0;
+    for (int attempt = 0; attempt < 40; attempt++) {
+        int resume = exists(dir, "ck");
+        const char *extra[] = {"--checkpoint", "ck", "--every", "0", resume ? "--resume" : NULL, "ck", NULL};
+        char out[64];
+        snprintf(out, sizeof out, "out%d.exr", attempt);
+        int last = attempt >= 6; /* after six kills, let it finish */
+        pid_t pid = start_render(dir, out, extra);
+        int sig = 0;
+        if (!last) {
+            double frac = (double)rand() / RAND_MAX;
+            struct timespec ts = {0, 0};
+            double d = frac * 0.6 * t_ref + 0.002;
+            ts.tv_sec = (time_t)d;
+            ts.tv_nsec = (long)((d - (double)ts.tv_sec) * 1e9);
+            nanosleep(&ts, NULL);
+            sig = rand() % 2 ? SIGINT : SIGTERM;
+            kill(pid, sig);
+        }
+        int st = wait_status(pid);
+        no_temporaries(dir);
+        if (WIFSIGNALED(st)) { /* killed before murk caught the signals: nothing written */
+            assert_int_equal(WTERMSIG(st), sig);
+            assert_false(exists(dir, out));
+            continue;
+        }
+        assert_true(WIFEXITED(st));
+        int rc = WEXITSTATUS(st);
+        if (rc == 0) {
+            murk_image img = {0};
+            read_exr(dir, out, &img);
+            assert_string_equal(murk_image_meta(&img, "murk:spp"), SPP);
+            assert_string_equal(murk_image_meta(&img, "murk:interrupted"), "no");
+            assert_int_equal(img.w, ref.w);
+            assert_int_equal(img.h, ref.h);
+            if (memcmp(img.rgb, ref.rgb, 3 * sizeof(float) * (size_t)img.w * (size_t)img.h) != 0) {
+                fprintf(stderr, "round %d: resumed render differs from the uninterrupted one\n", round);
+                fail();
+            }
+            murk_image_free(&img);
+            return kills;
+        }
+        assert_int_equal(rc, 128 + sig);
+        kills++;
+        if (exists(dir, out)) { /* the signal may also cut the image write short: then nothing is written */
+            murk_image img = {0};
+            read_exr(dir, out, &img);
+            const char *spp = murk_image_meta(&img, "murk:spp"), *why = murk_image_meta(&img, "murk:interrupted");
+            assert_non_null(spp);
+            assert_non_null(why);
+            char expect[96];
+            snprintf(expect, sizeof expect, "%s after %s of " SPP " spp", sig == SIGINT ? "SIGINT" : "SIGTERM", spp);
+            if (strcmp(spp, SPP) == 0) { /* the signal came after the last pass: the image is whole */
+                assert_string_equal(why, "no");
+                assert_memory_equal(img.rgb, ref.rgb, 3 * sizeof(float) * (size_t)img.w * (size_t)img.h);
+            } else {
+                assert_string_equal(why, expect);
+                assert_true(atoi(spp) < atoi(SPP));
+                (*interrupted_images)++;
+            }
+            murk_image_free(&img);
+        }
+    }
+    fail_msg("the render never finished");
+    return kills;
+}
+
+static void test_kill_resume_bitwise(void **state)
+{
+    (void)state;
+    render_reference();
+    int kills = 0, images = 0;
+    const char *seed_env = getenv("MURK_RESUME_SEED");
+    unsigned seed = seed_env ? (unsigned)strtoul(seed_env, NULL, 10) : (unsigned)time(NULL);
+    fprintf(stderr, "MURK_RESUME_SEED=%u\n", seed);
+    for (int round = 0; round < 4; round++)
+        kills += kill_and_resume(seed + (unsigned)round, round, &images);
+    fprintf(stderr, "%d renders interrupted (%d wrote their partial image), every resumed render bitwise identical\n",
+            kills, images);
+    assert_true(kills > 0);
+}
+
+/* A render interrupted mid-way: status 130, the image of the spp reached, metadata saying so. */
+static void test_interrupted_image(void **state)
+{
+    (void)state;
+    render_reference();
+    const char *dir = make_dir("interrupt");
+    const char *extra[] = {"--spp", "100000", "--checkpoint", "ck", "--every", "0", NULL};
+    pid_t pid = start_render(dir, "int.exr", extra);
+    struct timespec ts = {0, 20 * 1000 * 1000};
+    for (int i = 0; i < 3000 && !exists(dir, "ck"); i++) /* the first whole pass is done */
+        nanosleep(&ts, NULL);
+    kill(pid, SIGINT);
+    int st = wait_status(pid);
+    assert_true(WIFEXITED(st));
+    assert_int_equal(WEXITSTATUS(st), 130);
+    no_temporaries(dir);
+    murk_image img = {0};
+    read_exr(dir, "int.exr", &img);
+    int spp = atoi(murk_image_meta(&img, "murk:spp"));
+    assert_true(spp >= 1 && spp < 100000);
+    char expect[96];
+    snprintf(expect, sizeof expect, "SIGINT after %d of 100000 spp", spp);
+    assert_string_equal(murk_image_meta(&img, "murk:interrupted"), expect);
+    assert_string_equal(murk_image_meta(&img, "murk:spp_requested"), "100000");
+    murk_image_free(&img);
+    assert_true(exists(dir, "int.png"));
+}
+
+/* --resume refuses a checkpoint of another scene, of other overrides, or with more spp than asked. */
+static void test_resume_refuses(void **state)
+{
+    (void)state;
+    const char *dir = make_dir("refuse");
+    char ck[4096];
+    snprintf(ck, sizeof ck, "%s/ck", dir);
+    const char *extra[] = {"--checkpoint", "ck", NULL};
+    assert_int_equal(wait_status(start_render(dir, "a.exr", extra)), 0);
+    assert_true(exists(dir, "ck"));
+    char *out = NULL;
+    int rc = run_murk(&out, "render", src_path("scenes/cornell_smoke.yaml"), "-o", build_path("x_resume.exr"),
+                      "--resume", ck, "--quiet", NULL);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "checkpoint of another scene"));
+    free(out);
+    rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
+                  "render.resolution=[48,41]", NULL);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "other --set overrides"));
+    free(out);
+    rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
+                  "render.resolution=[48,40]", "--spp", "8", NULL);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "more than the 8 asked for"));
+    free(out);
+    /* a damaged checkpoint */
+    FILE *f = fopen(ck, "r+b");
+    assert_non_null(f);
+    fseek(f, 100, SEEK_SET);
+    fputc(0x5a, f);
+    fclose(f);
+    rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
+                  "render.resolution=[48,40]", NULL);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "damaged checkpoint"));
+    free(out);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_resume_refuses),
+        cmocka_unit_test(test_interrupted_image),
+        cmocka_unit_test(test_kill_resume_bitwise),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    murk_image_free(&ref);
+    return rc;
+}
