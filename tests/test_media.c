@@ -1,4 +1,4 @@
-/* test_media.c — the tracker plugins in-process, against closed forms (DESIGN §5-6).
+/* test_media.c — the tracker plugins in-process, against closed forms (murk/medium.h's invariants).
  *
  * Scenes are written to tmp_dir() and loaded with murk_scene_load (the plugins come from the build
  * tree); each tracker is then called directly through s->media[i].m.vt with murk_host_table() and a

@@ -1,4 +1,4 @@
-/* test_media_render.c — participating media end to end, through the murk command (DESIGN §5-6).
+/* test_media_render.c — participating media end to end, through the murk command (murk/medium.h's invariants).
  *
  *   furnace     a scattering-only medium (chromatic sigma_s) inside an index-matched sphere under a
  *               uniform unit background renders 1 everywhere, for every tracker x {volpath,
