@@ -13,6 +13,9 @@
  *              create() logs a warning.
  *   The effective alpha is clamped to [0.001, 1]: roughness 0 (or alpha 0) is a very sharp but finite
  *   GGX lobe, never a delta lobe, so eval/pdf/sample stay one smooth, MIS-able distribution.
+ *   multiscatter  bool, default true. Multiple-scattering compensation of the coat (below); false gives
+ *              the single-scattering model exactly as before it existed (for A/B: it loses up to 69 % of
+ *              the light at roughness 1).
  *
  * Model (local shading frame, n = +z, mu = cos theta):
  *   f = f_spec + f_diff
@@ -39,6 +42,24 @@
  * the bound E <= 1 rigorous. Mavg is integrated exactly from that same interpolant. The tables are
  * in ggx_tables.h, written by tools/ggx_tables.c (see there to regenerate them).
  *
+ * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, chosen over Turquin 2019
+ * because its extra lobe is symmetric in (wo, wi), so the BSDF stays reciprocal, and is sampled exactly by
+ * the cosine lobe the base already uses; Turquin's 1 + F0 (1 - E(mu_o)) / E(mu_o) scale of f_spec is not
+ * reciprocal). With E(mu) the coat's single-scattering albedo for F = 1 and Eavg its cosine average,
+ *   f_ms(wo,wi) = Fms (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Eavg)),
+ *   Fms = Favg^2 Eavg / (1 - Favg (1 - Eavg)),  Favg = F0 + (1 - F0) / 21 (Schlick's average),
+ * whose albedo is Fms (1 - E(mu_o)): with F0 = 1 the coat reflects E + 1 - E = 1 (the furnace). The base
+ * then sits under the coat's energy bound X instead of E_F:
+ *   X(mu) = F0 E(mu) + (1 - F0) M(mu) + Fms (1 - E(mu)),   f_diff = albedo (1 - X(mu_o)) (1 - X(mu_i)) / (pi (1 - Xavg)),
+ * because the single-scattering albedo with Schlick's Fresnel is F0 E + (1 - F0) E5 (E5: F = (1 - c)^5)
+ * and E5 <= M. So E(wo) <= X(wo) + albedo (1 - X(wo)) <= 1 again, and every term is symmetric. E is
+ * tabulated (ggx_e, with safety margins so that the table is never below E: the bound stays rigorous,
+ * and the compensated furnace is 1 minus at most that margin, 0.23 %) on the axis
+ * w = mu (1 + alpha) / (mu + alpha), which resolves E's dip near mu ~ alpha at low alpha; Eavg
+ * (ggx_eavg) is the exact average of that interpolant at 8 points per table row, interpolated between
+ * (error 2.4e-6). P_spec weighs the coat's single scattering F0 E + (1 - F0) M against the compensation
+ * lobe and the base together (both cosine-sampled).
+ *
  * Sampling: with probability P_spec the coat (visible-normal sampling of GGX with the spherical-cap
  * method of Dupuy & Benyoub 2023, then mirror reflection), otherwise the base (cosine-weighted
  * hemisphere). P_spec = lum(E_F(wo)) / (lum(E_F(wo)) + lum(albedo (1 - E_F(wo)))), the lobes'
@@ -54,7 +75,7 @@
 
 #include <string.h>
 
-enum { P_ALBEDO, P_SPECULAR, P_ROUGHNESS, P_ALPHA, P_COUNT };
+enum { P_ALBEDO, P_SPECULAR, P_ROUGHNESS, P_ALPHA, P_MULTISCATTER, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_ALBEDO] = {"albedo", MURK_PARAM_RGB, MURK_PARAM_TEXTURABLE, {0.5, 0.5, 0.5}, NULL, NULL, 0.0, 1.0,
@@ -65,6 +86,8 @@ static const murk_param params[P_COUNT] = {
                      "perceptual roughness; GGX alpha = roughness^2 (clamped to >= 0.001)"},
     [P_ALPHA] = {"alpha", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
                  "GGX alpha directly; if given it overrides roughness (clamped to >= 0.001)"},
+    [P_MULTISCATTER] = {"multiscatter", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
+                        "multiple-scattering compensation of the coat (Kulla & Conty 2017); false: single scattering"},
 };
 
 /* Cosines below this count as the horizon: it bounds f <= 0.5 D_max / (2 GGX_MU_MIN GGX_ALPHA_MIN) ~ 1e17
@@ -81,6 +104,7 @@ typedef struct ggx {
     const murk_host *host;
     murk_value p[P_COUNT];
     int use_alpha;
+    int ms; /* multiple-scattering compensation */
 } ggx;
 
 /* Parameter values at one hit. */
@@ -89,6 +113,10 @@ typedef struct ggx_shade {
     float alpha; /* clamped to [GGX_ALPHA_MIN, 1] */
     float r;     /* sqrt(alpha): the table's second axis */
     float mavg;  /* Mavg(alpha) */
+    int ms;      /* compensated: the fields below are set */
+    float eavg;  /* Eavg(alpha), average of the E table's interpolant */
+    float fms[3];  /* Kulla-Conty's Fresnel factor of the compensation lobe, per channel */
+    float xavg[3]; /* average of X (the coat's energy bound), per channel */
 } ggx_shade;
 
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
@@ -118,6 +146,20 @@ static void ggx_shade_at(const ggx *g, const murk_hit *hit, ggx_shade *sh)
         j = GGX_TAB_N - 2;
     float fr = x - (float)j;
     sh->mavg = ggx_mavg[j] + (ggx_mavg[j + 1] - ggx_mavg[j]) * fr;
+    sh->ms = g->ms;
+    if (sh->ms) {
+        enum { NA = (GGX_TAB_N - 1) * GGX_EAVG_SUB + 1 };
+        float y = sh->r * (float)(NA - 1);
+        int k = (int)y;
+        if (k > NA - 2)
+            k = NA - 2;
+        sh->eavg = ggx_eavg[k] + (ggx_eavg[k + 1] - ggx_eavg[k]) * (y - (float)k);
+        for (int c = 0; c < 3; c++) {
+            float f0 = sh->f0.c[c], favg = f0 + (1.0f - f0) * (1.0f / 21.0f); /* Schlick's hemispherical average */
+            sh->fms[c] = favg * favg * sh->eavg / fmaxf(1.0f - favg * (1.0f - sh->eavg), 1e-6f);
+            sh->xavg[c] = f0 * sh->eavg + (1.0f - f0) * sh->mavg + sh->fms[c] * (1.0f - sh->eavg);
+        }
+    }
 }
 
 /* Bilinear lookup of M(mu, alpha), mu in [0, 1]. */
@@ -138,6 +180,41 @@ static float ggx_m_lookup(const ggx_shade *sh, float mu)
     return m0 + (m1 - m0) * fr;
 }
 
+/* Bilinear lookup of E(mu, alpha), mu in [0, 1], on the table's axis w = mu (1 + alpha) / (mu + alpha). */
+static float ggx_e_lookup(const ggx_shade *sh, float mu)
+{
+    mu = clamp01(mu);
+    float w = mu * (1.0f + sh->alpha) / (mu + sh->alpha);
+    float t = clamp01(w) * (float)(GGX_TAB_N - 1);
+    int i = (int)t;
+    if (i > GGX_TAB_N - 2)
+        i = GGX_TAB_N - 2;
+    float ft = t - (float)i;
+    float x = sh->r * (float)(GGX_TAB_N - 1);
+    int j = (int)x;
+    if (j > GGX_TAB_N - 2)
+        j = GGX_TAB_N - 2;
+    float fr = x - (float)j;
+    float e0 = ggx_e[j][i] + (ggx_e[j][i + 1] - ggx_e[j][i]) * ft;
+    float e1 = ggx_e[j + 1][i] + (ggx_e[j + 1][i + 1] - ggx_e[j + 1][i]) * ft;
+    return e0 + (e1 - e0) * fr;
+}
+
+/* Compensated model at one cosine: e = E(mu), and per channel the coat's energy bound
+ * X = F0 E + (1 - F0) M + Fms (1 - E) (single scattering <= F0 E + (1 - F0) M, because E5 <= M) and
+ * 1 - X clamped to >= 0 (it is >= 0 up to rounding: 1 - X is concave in F0 and >= 0 at F0 = 0 and 1). */
+typedef struct ggx_msat { float e, m, ss[3], one_x[3]; } ggx_msat;
+static void ggx_ms_at(const ggx_shade *sh, float mu, ggx_msat *a)
+{
+    a->e = ggx_e_lookup(sh, mu);
+    a->m = ggx_m_lookup(sh, mu);
+    for (int c = 0; c < 3; c++) {
+        float f0 = sh->f0.c[c];
+        a->ss[c] = f0 * a->e + (1.0f - f0) * a->m;
+        a->one_x[c] = fmaxf(0.0f, 1.0f - a->ss[c] - sh->fms[c] * (1.0f - a->e));
+    }
+}
+
 /* Probability of sampling the coat, from the lobes' expected contributions at wo. mo = M(mu_o). */
 static float ggx_pspec(const ggx_shade *sh, float mo)
 {
@@ -154,6 +231,31 @@ static float ggx_pspec(const ggx_shade *sh, float mo)
         return 0.0f;
     float p = ws / (ws + wd);
     return p < GGX_PSPEC_MIN ? GGX_PSPEC_MIN : (p > GGX_PSPEC_MAX ? GGX_PSPEC_MAX : p);
+}
+
+/* The same for the compensated model: the coat's single scattering against everything sampled from the
+ * cosine (compensation lobe and base). */
+static float ggx_pspec_ms(const ggx_shade *sh, float mu_o)
+{
+    ggx_msat a;
+    ggx_ms_at(sh, mu_o, &a);
+    murk_rgb es, ed;
+    for (int c = 0; c < 3; c++) {
+        es.c[c] = a.ss[c];
+        ed.c[c] = sh->fms[c] * (1.0f - a.e) + sh->albedo.c[c] * a.one_x[c];
+    }
+    float ws = murk_luminance(es), wd = murk_luminance(ed);
+    if (!(wd > 0.0f))
+        return 1.0f;
+    if (!(ws > 0.0f))
+        return 0.0f;
+    float p = ws / (ws + wd);
+    return p < GGX_PSPEC_MIN ? GGX_PSPEC_MIN : (p > GGX_PSPEC_MAX ? GGX_PSPEC_MAX : p);
+}
+
+static float ggx_pspec_at(const ggx_shade *sh, float mu_o)
+{
+    return sh->ms ? ggx_pspec_ms(sh, mu_o) : ggx_pspec(sh, ggx_m_lookup(sh, mu_o));
 }
 
 static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); }
@@ -182,11 +284,24 @@ static murk_rgb ggx_eval_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     if (!above(wo.z) || !above(wi.z))
         return f;
     float mu_o = fminf(wo.z, 1.0f), mu_i = fminf(wi.z, 1.0f);
-    /* diffuse base */
-    float kd = (1.0f - ggx_m_lookup(sh, mu_o)) * (1.0f - ggx_m_lookup(sh, mu_i)) /
-               fmaxf(1.0f - sh->mavg, 1e-6f) * MURK_INV_PI;
-    for (int c = 0; c < 3; c++)
-        f.c[c] = sh->albedo.c[c] * (1.0f - sh->f0.c[c]) * kd;
+    if (sh->ms) { /* compensation lobe (Kulla & Conty 2017) and the base under the coat's bound X */
+        ggx_msat ao, ai;
+        ggx_ms_at(sh, mu_o, &ao);
+        ggx_ms_at(sh, mu_i, &ai);
+        float de = 1.0f - sh->eavg;
+        float kms = de > 1e-6f ? (1.0f - ao.e) * (1.0f - ai.e) / de * MURK_INV_PI : 0.0f;
+        for (int c = 0; c < 3; c++) {
+            float dx = 1.0f - sh->xavg[c];
+            f.c[c] = sh->fms[c] * kms;
+            if (dx > 1e-6f)
+                f.c[c] += sh->albedo.c[c] * ao.one_x[c] * ai.one_x[c] / dx * MURK_INV_PI;
+        }
+    } else { /* diffuse base */
+        float kd = (1.0f - ggx_m_lookup(sh, mu_o)) * (1.0f - ggx_m_lookup(sh, mu_i)) /
+                   fmaxf(1.0f - sh->mavg, 1e-6f) * MURK_INV_PI;
+        for (int c = 0; c < 3; c++)
+            f.c[c] = sh->albedo.c[c] * (1.0f - sh->f0.c[c]) * kd;
+    }
     /* specular coat */
     murk_vec3 h;
     if (ggx_half(wo, wi, &h)) {
@@ -207,7 +322,7 @@ static float ggx_pdf_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     if (!above(wo.z) || !above(wi.z))
         return 0.0f;
     float mu_o = fminf(wo.z, 1.0f), mu_i = fminf(wi.z, 1.0f);
-    float ps = ggx_pspec(sh, ggx_m_lookup(sh, mu_o));
+    float ps = ggx_pspec_at(sh, mu_o);
     float pdf = (1.0f - ps) * mu_i * MURK_INV_PI;
     murk_vec3 h;
     if (ps > 0.0f && ggx_half(wo, wi, &h)) {
@@ -244,6 +359,7 @@ static int ggx_create(const murk_host *host, const murk_value *p, void **self, c
     g->host = host;
     memcpy(g->p, p, sizeof g->p);
     g->use_alpha = p[P_ALPHA].set != 0;
+    g->ms = p[P_MULTISCATTER].f[0] != 0.0;
     if (g->use_alpha && p[P_ROUGHNESS].set && host->log)
         host->log(MURK_LOG_WARN, "ggx: both 'roughness' and 'alpha' given; 'alpha' overrides 'roughness'");
     *self = g;
@@ -282,7 +398,7 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
         return 0;
     ggx_shade sh;
     ggx_shade_at(self, hit, &sh);
-    float ps = ggx_pspec(&sh, ggx_m_lookup(&sh, fminf(wo.z, 1.0f)));
+    float ps = ggx_pspec_at(&sh, fminf(wo.z, 1.0f));
     murk_vec3 wi;
     if (u[2] < ps) {
         murk_vec3 h = ggx_sample_vndf(wo, sh.alpha, u[0], u[1]);
