@@ -280,22 +280,10 @@ static const char *type_name(uint32_t t)
     return t <= MURK_PARAM_ENUM ? names[t] : "?";
 }
 
-static void describe(const murk_plugin *p)
+static void print_params(const murk_param *ps, uint32_t n)
 {
-    const murk_plugin_desc *d = p->desc;
-    printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description, p->path, p->version ? p->version : "none",
-           p->abi.major, p->abi.minor);
-    if (d->kind == MURK_KIND_MEDIUM)
-        printf("  common medium keys (handled by the core): density, sigma_a, sigma_s, scale, g, majorant_factor, majorant_resolution, transmittance\n");
-    if (d->kind == MURK_KIND_TRANSMITTANCE)
-        printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name, d->name);
-    if (!d->nparams) {
-        printf("  no parameters\n");
-        return;
-    }
-    printf("  parameters:\n");
-    for (uint32_t i = 0; i < d->nparams; i++) {
-        const murk_param *q = &d->params[i];
+    for (uint32_t i = 0; i < n; i++) {
+        const murk_param *q = &ps[i];
         char def[128], range[96] = "";
         switch (q->type) {
         case MURK_PARAM_RGB:
@@ -315,9 +303,31 @@ static void describe(const murk_plugin *p)
             snprintf(range, sizeof range, "one of %s", q->choices);
         else if (q->type != MURK_PARAM_STRING && q->type != MURK_PARAM_BOOL)
             snprintf(range, sizeof range, "[%g, %g]", q->min, q->max);
-        printf("    %-16s %-6s default %-18s %-22s %s%s%s\n", q->name, type_name(q->type), def, range, q->doc,
+        printf("    %-19s %-6s default %-18s %-22s %s%s%s\n", q->name, type_name(q->type), def, range, q->doc,
                (q->flags & MURK_PARAM_TEXTURABLE) ? " (texturable)" : "", (q->flags & MURK_PARAM_REQUIRED) ? " (required)" : "");
     }
+}
+
+static void describe(const murk_plugin *p)
+{
+    const murk_plugin_desc *d = p->desc;
+    printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description,
+           p->path, p->version ? p->version : "none", p->abi.major, p->abi.minor);
+    if (d->kind == MURK_KIND_MEDIUM) {
+        printf("  medium keys (read by the core, for every tracker):\n");
+        printf("    %-19s %-6s %s\n", "density", "map", "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }");
+        print_params(murk_medium_core_params, MURK_MEDIUM_NCORE);
+        printf("    %-19s %-6s %s\n", "transmittance", "name",
+               "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)");
+    }
+    if (d->kind == MURK_KIND_TRANSMITTANCE)
+        printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name, d->name);
+    if (!d->nparams) {
+        printf("  no parameters of its own\n");
+        return;
+    }
+    printf("  parameters:\n");
+    print_params(d->params, d->nparams);
 }
 
 static int cmd_plugins(int argc, char **argv)

@@ -1,7 +1,7 @@
 /* density.h — scalar density fields, their majorant/minorant grids and a 3-D DDA. Internal to libmurk.
  *
  * A field is either a constant (infinite extent) or a dense grid of float voxels over a world-space
- * box [lo, hi] (DESIGN §5): voxel values sit at the CENTRES of the res[0] x res[1] x res[2] cells of
+ * box [lo, hi] (README, "Media"): voxel values sit at the CENTRES of the res[0] x res[1] x res[2] cells of
  * that box; murk_field_eval interpolates trilinearly between centres, clamps to the nearest centre
  * in the border half-cells (so the value there is constant along the clamped axis) and returns 0
  * outside the closed box (and for NaN positions). Grid values are finite and >= 0.

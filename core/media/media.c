@@ -132,15 +132,6 @@ murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *p
 
 /* ---- scene loading ------------------------------------------------------------------------- */
 
-static int rgb(const murk_ynode *n, const char *what, double lo, double hi, murk_rgb *out, char *err, size_t errlen)
-{
-    double v[3];
-    if (murk_yread_rgb(n, what, lo, hi, v, err, errlen))
-        return -1;
-    *out = murk_rgb3((float)v[0], (float)v[1], (float)v[2]);
-    return 0;
-}
-
 static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
 {
     static const char *const keys[] = {"min", "max", "seed", "frequency", "octaves", "coverage", "resolution"};
@@ -205,9 +196,34 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
     return load_cloud(murk_ymap_get(d, "cloud"), err, errlen);
 }
 
-static const char *const core_keys[] = {"type", "density", "sigma_a", "sigma_s", "scale", "g", "majorant_factor",
-                                        "majorant_resolution", "transmittance"};
-#define NCORE (sizeof core_keys / sizeof core_keys[0])
+/* The keys every medium has, whatever its tracker: read by the core with the same schema reader as a
+ * plugin's parameters, and listed with them by `murk plugins TRACKER`. `density` and `transmittance`
+ * (maps or names) are read separately (murk_medium_special_keys). */
+enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_COUNT };
+MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
+    [K_SIGMA_A] = {"sigma_a", MURK_PARAM_RGB, 0, {0, 0, 0}, NULL, NULL, 0, 1e8, "absorption per unit density"},
+    [K_SIGMA_S] = {"sigma_s", MURK_PARAM_RGB, 0, {1, 1, 1}, NULL, NULL, 0, 1e8, "scattering per unit density"},
+    [K_SCALE] = {"scale", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 1e8, "multiplies sigma_a and sigma_s"},
+    [K_G] = {"g", MURK_PARAM_FLOAT, 0, {0, 0, 0}, NULL, NULL, -0.99, 0.99, "Henyey-Greenstein asymmetry"},
+    [K_MAJORANT_FACTOR] = {"majorant_factor", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 1e-3, 1e3,
+                           "multiplies the majorant grid; < 1 no longer bounds (trackers stay unbiased, noisier)"},
+    [K_MAJORANT_RESOLUTION] = {"majorant_resolution", MURK_PARAM_INT, 0, {16, 0, 0}, NULL, NULL, 1, 256,
+                               "majorant/minorant grid cells along the field box's longest axis"},
+};
+MURK_API const char *const murk_medium_special_keys[2] = {"density", "transmittance"};
+
+/* Keys of the block that the core's schema does not read: "type", the special keys and the tracker's
+ * own parameters. */
+static size_t skip_keys(const murk_plugin_desc *d, const char **out, size_t cap)
+{
+    size_t n = 0;
+    out[n++] = "type";
+    for (size_t i = 0; i < 2; i++)
+        out[n++] = murk_medium_special_keys[i];
+    for (uint32_t i = 0; d && i < d->nparams && n < cap; i++)
+        out[n++] = d->params[i].name;
+    return n;
+}
 
 /* `transmittance: NAME` or `transmittance: { type: NAME, key: value, ... }`: the medium's estimator plugin,
  * its parameters checked against its schema like a tracker's, created on the medium's data. */
@@ -219,66 +235,59 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
     if (!t || t->kind != MURK_Y_SCALAR || !*t->str)
         return murk_yerr(err, errlen, t ? t : n, "medium '%s': transmittance must be an estimator's name or "
                          "{ type: NAME, ... } (murk plugins lists the transmittance kind)", name);
-    char lerr[1024], who[256];
-    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_TRANSMITTANCE, t->str, lerr, sizeof lerr);
-    if (!p)
-        return murk_yerr(err, errlen, t, "medium '%s': transmittance: %s", name, lerr);
+    char block[256], who[256];
+    snprintf(block, sizeof block, "medium '%s': transmittance", name);
     snprintf(who, sizeof who, "medium '%s' transmittance (%s)", name, t->str);
-    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
-    if (murk_scene_read_plugin_params(s, p->desc, n, who, skip, n->kind == MURK_Y_MAP ? 1 : 0, vals, err, errlen))
+    const murk_plugin *p;
+    if (murk_scene_instantiate(s, MURK_KIND_TRANSMITTANCE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP,
+                               &nm->data, &p, &nm->m.tr_self, err, errlen))
         return -1;
-    const murk_transmittance_vt *vt = p->desc->vtable;
-    char cerr[512] = "";
-    if (vt->create(murk_host_table(), &nm->data, vals, &nm->m.tr_self, cerr, sizeof cerr) != 0)
-        return murk_yerr(err, errlen, n, "%s: %s", who, cerr[0] ? cerr : "create() failed");
-    nm->m.tr_vt = vt;
+    nm->m.tr_vt = p->desc->vtable;
     return 0;
 }
 
 static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
                        size_t errlen)
 {
-    char who[256];
-    snprintf(who, sizeof who, "medium '%s'", name);
+    char block[256], who[256];
+    snprintf(block, sizeof block, "medium '%s'", name);
     if (m->kind != MURK_Y_MAP)
-        return murk_yerr(err, errlen, m, "%s must be a map of keys", who);
+        return murk_yerr(err, errlen, m, "%s must be a map of keys", block);
     const murk_ynode *t = murk_ymap_get(m, "type");
     if (!t)
         return murk_yerr(err, errlen, m, "%s is missing the required key 'type' (a tracker: delta, decomposition, "
-                                         "spectral, spectral_mis, naive_spectral)", who);
+                                         "spectral, spectral_mis, naive_spectral)", block);
     if (t->kind != MURK_Y_SCALAR)
-        return murk_yerr(err, errlen, t, "%s: type must be a plugin name", who);
-    char lerr[1024];
-    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_MEDIUM, t->str, lerr, sizeof lerr);
-    if (!p)
-        return murk_yerr(err, errlen, t, "%s: %s", who, lerr);
+        return murk_yerr(err, errlen, t, "%s: type must be a plugin name", block);
     snprintf(who, sizeof who, "medium '%s' (%s)", name, t->str);
-    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
-    if (murk_scene_read_plugin_params(s, p->desc, m, who, core_keys, NCORE, vals, err, errlen))
+    /* the core's keys first (the tracker's own keys are skipped here and read by murk_scene_instantiate) */
+    char lerr[1024];
+    const murk_plugin *tp = murk_registry_load(&s->reg, MURK_KIND_MEDIUM, t->str, lerr, sizeof lerr);
+    if (!tp)
+        return murk_yerr(err, errlen, t, "%s: %s", block, lerr);
+    const char *skip[128];
+    size_t nskip = skip_keys(tp->desc, skip, 128);
+    /* the core's schema under the tracker's name, so that messages point to `murk plugins TRACKER` */
+    const murk_plugin_desc core_desc = {sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, tp->desc->name, "the core's keys",
+                                        murk_medium_core_params, MURK_MEDIUM_NCORE, NULL, NULL};
+    murk_value core[MURK_MEDIUM_NCORE];
+    if (murk_scene_read_plugin_params(s, &core_desc, m, who, skip, nskip, core, err, errlen))
         return -1;
-
     murk_medium_data *md = &nm->data;
     md->size = sizeof *md;
-    md->sigma_a = murk_rgb1(0.0f);
-    md->sigma_s = murk_rgb1(1.0f);
-    double scale = 1.0, g = 0.0, mf = 1.0, mres = 16;
-    const murk_ynode *k;
-    if (((k = murk_ymap_get(m, "sigma_a")) && rgb(k, "sigma_a", 0, 1e8, &md->sigma_a, err, errlen)) ||
-        ((k = murk_ymap_get(m, "sigma_s")) && rgb(k, "sigma_s", 0, 1e8, &md->sigma_s, err, errlen)) ||
-        ((k = murk_ymap_get(m, "scale")) && murk_yread_range(k, "scale", 0, 1e8, &scale, err, errlen)) ||
-        ((k = murk_ymap_get(m, "g")) && murk_yread_range(k, "g (Henyey-Greenstein asymmetry)", -0.99, 0.99, &g, err, errlen)) ||
-        ((k = murk_ymap_get(m, "majorant_factor")) && murk_yread_range(k, "majorant_factor", 1e-3, 1e3, &mf, err, errlen)) ||
-        ((k = murk_ymap_get(m, "majorant_resolution")) && murk_yread_range(k, "majorant_resolution", 1, 256, &mres, err, errlen)))
-        return -1;
-    md->sigma_a = murk_rgb_scale(md->sigma_a, (float)scale);
-    md->sigma_s = murk_rgb_scale(md->sigma_s, (float)scale);
-    md->g = (float)g;
+    float scale = (float)core[K_SCALE].f[0];
+    md->sigma_a = murk_rgb_scale(murk_rgb3((float)core[K_SIGMA_A].f[0], (float)core[K_SIGMA_A].f[1],
+                                           (float)core[K_SIGMA_A].f[2]), scale);
+    md->sigma_s = murk_rgb_scale(murk_rgb3((float)core[K_SIGMA_S].f[0], (float)core[K_SIGMA_S].f[1],
+                                           (float)core[K_SIGMA_S].f[2]), scale);
+    md->g = (float)core[K_G].f[0];
+    double mf = core[K_MAJORANT_FACTOR].f[0];
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);
     nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
     if (!nm->density->field)
         return -1;
-    if (murk_bound_grid_build(nm->density->field, (int)mres, &nm->density->grid) != 0)
+    if (murk_bound_grid_build(nm->density->field, (int)core[K_MAJORANT_RESOLUTION].f[0], &nm->density->grid) != 0)
         return murk_yerr(err, errlen, dn ? dn : m, "%s: cannot build the majorant grid (out of memory)", who);
     nm->density->factor = (float)mf;
     md->density = nm->density;
@@ -293,11 +302,18 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
         murk_log(MURK_LOG_INFO, "%s: extinction varies %.0f:1 across channels (strongly chromatic)", who,
                  mn > 0 ? sm / mn : INFINITY);
 
-    const murk_medium_vt *vt = p->desc->vtable;
-    char cerr[512] = "";
-    if (vt->create(murk_host_table(), md, vals, &nm->m.self, cerr, sizeof cerr) != 0)
-        return murk_yerr(err, errlen, m, "%s: %s", who, cerr[0] ? cerr : "create() failed");
-    nm->m.vt = vt;
+    /* then the tracker, with the core's keys skipped */
+    nskip = 0;
+    skip[nskip++] = "type";
+    for (size_t i = 0; i < 2; i++)
+        skip[nskip++] = murk_medium_special_keys[i];
+    for (size_t i = 0; i < MURK_MEDIUM_NCORE; i++)
+        skip[nskip++] = murk_medium_core_params[i].name;
+    const murk_plugin *p;
+    if (murk_scene_instantiate(s, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self, err,
+                               errlen))
+        return -1;
+    nm->m.vt = p->desc->vtable;
     nm->m.name = nm->name;
     nm->m.data = md;
     nm->plugin = p;

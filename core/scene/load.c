@@ -25,11 +25,6 @@ static murk_rgb to_rgb(const double d[3]) { return murk_rgb3((float)d[0], (float
 #define NKEYS(a) (sizeof(a) / sizeof((a)[0]))
 
 /* Prefixes an error that create() returned with the block's location. */
-static int create_failed(const murk_ynode *n, const char *who, const char *msg, char *err, size_t errlen)
-{
-    return ERR(n, "%s: %s", who, msg[0] ? msg : "create() failed");
-}
-
 /* ---- Blocks ------------------------------------------------------------------------------------ */
 
 static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
@@ -176,23 +171,17 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
         const char *type = NULL;
         if (!t || murk_yread_string(t, "type", &type, err, errlen))
             return -1;
-        char lerr[1024];
-        const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_MATERIAL, type, lerr, sizeof lerr);
-        if (!p)
-            return ERR(t, "%s: %s", who, lerr);
-        snprintf(who, sizeof who, "material '%s' (%s)", n->keys[i], type);
         static const char *const skip[] = {"type"};
-        murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
-        if (murk_scene_read_plugin_params(s, p->desc, m, who, skip, 1, vals, err, errlen))
-            return -1;
         murk_named_material *nm = &s->materials[s->nmaterials];
-        const murk_material_vt *vt = p->desc->vtable;
-        char cerr[512] = "";
-        void *self = NULL;
-        if (vt->create(murk_host_table(), vals, &self, cerr, sizeof cerr) != 0)
-            return create_failed(m, who, cerr, err, errlen);
+        const murk_plugin *p;
+        void *self;
+        char who_type[512];
+        snprintf(who_type, sizeof who_type, "%s (%s)", who, type);
+        if (murk_scene_instantiate(s, MURK_KIND_MATERIAL, t, type, m, who, who_type, skip, 1, NULL, &p, &self, err,
+                                   errlen))
+            return -1;
         nm->name = murk_strdup(n->keys[i]);
-        nm->m.vt = vt;
+        nm->m.vt = p->desc->vtable;
         nm->m.self = self;
         nm->m.name = nm->name;
         nm->plugin = p;
@@ -215,20 +204,14 @@ static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t
     } else {
         n = &empty;
     }
-    char lerr[1024], who[256];
-    const murk_plugin *p = murk_registry_load(&s->reg, MURK_KIND_INTEGRATOR, type, lerr, sizeof lerr);
-    if (!p) {
-        const murk_ynode *t = murk_ymap_get(n, "type");
-        return ERR(t ? t : n, "integrator: %s", lerr);
-    }
+    const murk_plugin *p;
+    const murk_ynode *t = murk_ymap_get(n, "type");
+    char who[256];
     snprintf(who, sizeof who, "integrator '%s'", type);
-    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
-    if (murk_scene_read_plugin_params(s, p->desc, n, who, skip, 1, vals, err, errlen))
+    if (murk_scene_instantiate(s, MURK_KIND_INTEGRATOR, t ? t : n, type, n, "integrator", who, skip, 1, NULL, &p,
+                               &s->integrator, err, errlen))
         return -1;
     const murk_integrator_vt *vt = p->desc->vtable;
-    char cerr[512] = "";
-    if (vt->create(murk_host_table(), vals, &s->integrator, cerr, sizeof cerr) != 0)
-        return create_failed(n, who, cerr, err, errlen);
     s->integrator_plugin = p;
     s->integrator_vt = vt;
     return 0;

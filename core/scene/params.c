@@ -2,10 +2,15 @@
  * schema (types, ranges, choices, textures, required keys), for the scene loader (load.c) and the
  * media loader (media.c). */
 #include "params.h"
+#include "host.h"
 #include "scene.h"
 #include "texture.h"
 #include "util.h"
 #include "yread.h"
+
+#include "murk/integrator.h"
+#include "murk/material.h"
+#include "murk/transmittance.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -136,5 +141,37 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
     for (uint32_t i = 0; i < d->nparams; i++)
         if ((d->params[i].flags & MURK_PARAM_REQUIRED) && !values[i].set)
             return murk_yerr(err, errlen, map, "%s is missing the required parameter '%s'", who, d->params[i].name);
+    return 0;
+}
+
+int murk_scene_instantiate(murk_scene *s, int kind, const murk_ynode *type_node, const char *type, const murk_ynode *map,
+                           const char *block, const char *who, const char *const *skip, size_t nskip,
+                           const murk_medium_data *data, const murk_plugin **plugin, void **self, char *err,
+                           size_t errlen)
+{
+    char lerr[1024];
+    const murk_plugin *p = murk_registry_load(&s->reg, kind, type, lerr, sizeof lerr);
+    if (!p)
+        return ERR(type_node, "%s: %s", block, lerr);
+    murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
+    if (murk_scene_read_plugin_params(s, p->desc, map, who, skip, nskip, vals, err, errlen))
+        return -1;
+    const murk_host *host = murk_host_table();
+    char cerr[512] = "";
+    int rc;
+    switch (kind) {
+    case MURK_KIND_MATERIAL: rc = ((const murk_material_vt *)p->desc->vtable)->create(host, vals, self, cerr, sizeof cerr); break;
+    case MURK_KIND_INTEGRATOR: rc = ((const murk_integrator_vt *)p->desc->vtable)->create(host, vals, self, cerr, sizeof cerr); break;
+    case MURK_KIND_MEDIUM: rc = ((const murk_medium_vt *)p->desc->vtable)->create(host, data, vals, self, cerr, sizeof cerr); break;
+    case MURK_KIND_TRANSMITTANCE:
+        rc = ((const murk_transmittance_vt *)p->desc->vtable)->create(host, data, vals, self, cerr, sizeof cerr);
+        break;
+    default: rc = -1; snprintf(cerr, sizeof cerr, "unknown plugin kind %d", kind);
+    }
+    if (rc != 0) {
+        *self = NULL;
+        return ERR(map, "%s: %s", who, cerr[0] ? cerr : "create() failed");
+    }
+    *plugin = p;
     return 0;
 }

@@ -45,7 +45,5 @@ int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_
                     size_t errlen);
 /* FNV-1a 64 of a file's bytes (a scene's content hash for checkpoints); 0 with err set if unreadable. */
 uint64_t murk_file_hash(const char *path, char *err, size_t errlen);
-/* The `murk` command line (render / plugins / compare / grid); returns the exit status. */
-int murk_cli_main(int argc, char **argv);
 
 #endif
