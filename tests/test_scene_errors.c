@@ -128,7 +128,7 @@ static const bad_scene corpus[] = {
     {"two documents", NULL, HEAD "shapes: []\n---\nmurk: 1\n", NULL, 5, 1, 0, "a scene file holds one YAML document"},
     {"complex key", NULL, HEAD "? [a, b]\n: 1\n", NULL, 4, 3, 0, "a map key must be a plain name"},
     {"mesh file is a folder", NULL, HEAD "shapes:\n  - { type: mesh, file: ., material: white }\n", NULL, 5, 25, 0,
-     "Is a directory"},
+     "a directory, not a regular file"},
     {"NaN background", NULL, HEAD "background: .nan\nshapes: []\n", NULL, 4, 13, 0, "background must be a number"},
 };
 #define NCORPUS (sizeof corpus / sizeof corpus[0])

@@ -8,7 +8,9 @@
 #include "check.h"
 #include "cli.h"
 #include "density.h"
+#include "atomic.h"
 #include "image.h"
+#include "limit.h"
 #include "media.h"
 #include "plugin_loader.h"
 #include "scene.h"
@@ -21,6 +23,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static const char usage_text[] =
@@ -32,6 +35,20 @@ static const char usage_text[] =
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
     "  murk --version\n";
+
+/* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
+ * eight rotating buffers, so one message may quote several. */
+static const char *q(const char *s)
+{
+    static char buf[8][1024];
+    static int k;
+    k = (k + 1) % 8;
+    return murk_printable(buf[k], sizeof buf[k], s);
+}
+
+/* "murk: MESSAGE" for a message built from input (the scene's and loaders' errors are printable
+ * already; plugin and image errors may quote a raw argument). */
+static void cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", q(msg)); }
 
 static int usage(const char *msg)
 {
@@ -45,9 +62,9 @@ static int parse_int_arg(const char *opt, const char *v, long lo, long hi, long 
 {
     char *end;
     errno = 0;
-    long x = v ? strtol(v, &end, 10) : 0;
-    if (!v || !*v || *end || errno || x < lo || x > hi) {
-        fprintf(stderr, "murk: %s needs a whole number in [%ld, %ld], got '%s'\n", opt, lo, hi, v ? v : "");
+    long x = v && ((*v >= '0' && *v <= '9') || *v == '-') ? strtol(v, &end, 10) : 0;
+    if (!v || !*v || !((*v >= '0' && *v <= '9') || *v == '-') || *end || errno || x < lo || x > hi) {
+        fprintf(stderr, "murk: %s needs a whole number in [%ld, %ld], got '%s'\n", opt, lo, hi, q(v ? v : ""));
         return -1;
     }
     *out = x;
@@ -164,12 +181,12 @@ static int cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
             quiet = 1;
         } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "murk: unknown option '%s'\n", a);
+            fprintf(stderr, "murk: unknown option '%s'\n", q(a));
             return free(sets), usage(NULL);
         } else if (!scene_path) {
             scene_path = a;
         } else {
-            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n", scene_path, a);
+            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n", q(scene_path), q(a));
             return free(sets), 2;
         }
     }
@@ -177,13 +194,31 @@ static int cmd_render(int argc, char **argv)
         return free(sets), usage("render needs a scene file");
     if (every_given && !opts.checkpoint)
         return free(sets), usage("--every needs --checkpoint");
+    struct stat sst;
+    if (stat(scene_path, &sst) == 0 && !S_ISREG(sst.st_mode)) { /* before deriving an output name from it */
+        fprintf(stderr, "%s: is %s, not a scene file\n", q(scene_path), /* as the loader would say it */
+                S_ISDIR(sst.st_mode) ? "a directory" : S_ISFIFO(sst.st_mode) ? "a FIFO" :
+                S_ISCHR(sst.st_mode) || S_ISBLK(sst.st_mode) ? "a device" : "not a regular file");
+        return free(sets), 1;
+    }
     char *outbuf = out ? murk_strdup(out) : default_output(scene_path);
     size_t ol = strlen(outbuf);
     if (ol < 5 || strcmp(outbuf + ol - 4, ".exr") != 0) {
-        fprintf(stderr, "murk: the output file must end in .exr, got '%s'\n", outbuf);
+        fprintf(stderr, "murk: the output file must end in .exr, got '%s'\n", q(outbuf));
         free(outbuf);
         free(sets);
         return 2;
+    }
+    {   /* refuse before rendering: an output path naming a directory, device, FIFO or link */
+        char oerr[1024], *png0 = png_path_for(outbuf);
+        int bad = murk_output_check(outbuf, oerr, sizeof oerr) || murk_output_check(png0, oerr, sizeof oerr);
+        free(png0);
+        if (bad) {
+            cli_error(oerr);
+            free(outbuf);
+            free(sets);
+            return 1;
+        }
     }
     murk_set_quiet(quiet);
     char err[2048];
@@ -245,10 +280,13 @@ static int cmd_render(int argc, char **argv)
         fprintf(stderr, "murk: interrupted (%s): writing the image with %d of %s spp%s%s\n",
                 render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked,
                 opts.checkpoint ? "; resume with --resume " : "", opts.checkpoint ? opts.checkpoint : "");
+    murk_output_begin(); /* the EXR and its PNG: both files or neither */
     if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, (int)(sizeof meta / sizeof meta[0]), err,
                        sizeof err) != 0 ||
-        murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0) {
-        fprintf(stderr, "murk: %s\n", err);
+        murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0 ||
+        murk_output_commit(err, sizeof err) != 0) {
+        murk_output_abort();
+        cli_error(err);
         rc = 1;
     }
     if (res.interrupted || render_stop) /* also when the signal came during the writes and cut them short */
@@ -345,7 +383,7 @@ static int cmd_plugins(int argc, char **argv)
         if (p)
             describe(p);
         else {
-            fprintf(stderr, "murk: %s\n", err);
+            cli_error(err);
             rc = 1;
         }
         murk_registry_free(&reg);
@@ -423,7 +461,7 @@ static int cmd_compare(int argc, char **argv)
     murk_image A = {0}, B = {0};
     char err[1024];
     if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
-        fprintf(stderr, "murk: %s\n", err);
+        cli_error(err);
         murk_image_free(&A);
         return 1;
     }
@@ -474,7 +512,7 @@ static int cmd_compare(int argc, char **argv)
                     rgb[3 * i + (size_t)c] = powf(rgb[3 * i + (size_t)c], 2.2f);
             }
             if (murk_png_write(diff, rgb, A.w, A.h, 0.0f, err, sizeof err)) {
-                fprintf(stderr, "murk: %s\n", err);
+                cli_error(err);
                 rc = 1;
             } else {
                 printf("diff image %s: |a-b| averaged over channels, white = 99th percentile (%.3e)\n", diff, p99);
@@ -490,27 +528,52 @@ static int cmd_compare(int argc, char **argv)
 
 /* ---- grid ---------------------------------------------------------------------------------- */
 
-static int parse_vec3_arg(const char *opt, const char *v, murk_vec3 *out)
+/* A number read as strictly as the scene's (yread.c): a whole decimal token, no leading space, no hex,
+ * no nan or inf; whole = 1 also refuses a fraction. 0, or -1 after a message naming the problem. */
+static int parse_number(const char *opt, const char *v, int whole, double lo, double hi, double *out)
 {
-    float x, y, z;
-    char extra;
-    if (!v || sscanf(v, "%f,%f,%f%c", &x, &y, &z, &extra) != 3 || !isfinite(x) || !isfinite(y) || !isfinite(z)) {
-        fprintf(stderr, "murk: %s needs X,Y,Z, got '%s'\n", opt, v ? v : "");
+    char *end = NULL;
+    errno = 0;
+    int ok = v && *v && (*v == '-' || *v == '+' || *v == '.' || (*v >= '0' && *v <= '9')) &&
+             !(v[0] == '0' && (v[1] == 'x' || v[1] == 'X'));
+    double x = ok ? strtod(v, &end) : 0;
+    if (!ok || *end || !isfinite(x)) {
+        fprintf(stderr, "murk: %s needs %s, got '%s'\n", opt, whole ? "a whole number" : "a number", q(v ? v : ""));
         return -1;
     }
-    *out = murk_v3(x, y, z);
-    return 0;
-}
-
-static int parse_float_arg(const char *opt, const char *v, double lo, double hi, double *out)
-{
-    char *end;
-    double x = v ? strtod(v, &end) : 0;
-    if (!v || !*v || *end || !(x >= lo && x <= hi)) {
-        fprintf(stderr, "murk: %s needs a number in [%g, %g], got '%s'\n", opt, lo, hi, v ? v : "");
+    if (whole && x != floor(x)) {
+        fprintf(stderr, "murk: %s must be a whole number, got '%s'\n", opt, q(v));
+        return -1;
+    }
+    if (!(x >= lo && x <= hi)) {
+        fprintf(stderr, "murk: %s must be in [%.*g, %.*g], got '%s'\n", opt, whole ? 12 : 6, lo, whole ? 12 : 6, hi, q(v));
         return -1;
     }
     *out = x;
+    return 0;
+}
+
+static int parse_vec3_arg(const char *opt, const char *v, murk_vec3 *out)
+{
+    double c[3];
+    char part[3][128];
+    const char *p = v;
+    for (int k = 0; k < 3; k++) {
+        const char *e = p ? strchr(p, ',') : NULL;
+        if (k == 2)
+            e = p ? p + strlen(p) : NULL;
+        if (!p || !e || (size_t)(e - p) >= sizeof part[k] || (k == 2 && strchr(p, ','))) {
+            fprintf(stderr, "murk: %s needs X,Y,Z, got '%s'\n", opt, q(v ? v : ""));
+            return -1;
+        }
+        memcpy(part[k], p, (size_t)(e - p));
+        part[k][e - p] = 0;
+        p = *e ? e + 1 : NULL;
+    }
+    for (int k = 0; k < 3; k++)
+        if (parse_number(opt, part[k], 0, -MURK_MAX_COORD, MURK_MAX_COORD, &c[k]))
+            return -1;
+    *out = murk_v3((float)c[0], (float)c[1], (float)c[2]);
     return 0;
 }
 
@@ -528,18 +591,19 @@ static int cmd_grid(int argc, char **argv)
         else if (!strcmp(a, "--max"))
             bad = parse_vec3_arg(a, v, &hi), i++;
         else if (!strcmp(a, "--res"))
-            bad = parse_float_arg(a, v, 2, 1024, &res), i++;
+            bad = parse_number(a, v, 1, 2, 1024, &res), i++;
         else if (!strcmp(a, "--seed"))
-            bad = parse_float_arg(a, v, 0, 4294967295.0, &seed), i++;
+            bad = parse_number(a, v, 1, 0, 4294967295.0, &seed), i++;
         else if (!strcmp(a, "--frequency"))
-            bad = parse_float_arg(a, v, 0.01, 1000, &freq), i++;
+            bad = parse_number(a, v, 0, 0.01, 1000, &freq), i++;
         else if (!strcmp(a, "--octaves"))
-            bad = parse_float_arg(a, v, 1, 16, &oct), i++;
+            bad = parse_number(a, v, 1, 1, 16, &oct), i++;
         else if (!strcmp(a, "--coverage"))
-            bad = parse_float_arg(a, v, 0, 1, &cov), i++;
-        else if (a[0] == '-')
-            return usage("unknown grid option");
-        else if (!out)
+            bad = parse_number(a, v, 0, 0, 1, &cov), i++;
+        else if (a[0] == '-') {
+            fprintf(stderr, "murk: unknown grid option '%s'\n", q(a));
+            return usage(NULL);
+        } else if (!out)
             out = a;
         else
             return usage("grid takes one output file");
@@ -552,17 +616,30 @@ static int cmd_grid(int argc, char **argv)
         fprintf(stderr, "murk: --max must exceed --min on every axis\n");
         return 2;
     }
-    murk_field *f = murk_field_cloud(lo, hi, (int)res, (uint64_t)seed, (float)freq, (int)oct, (float)cov);
     char err[1024];
-    if (!f) {
-        fprintf(stderr, "murk: could not build the cloud (out of memory?)\n");
+    if (murk_output_check(out, err, sizeof err) != 0) { /* before the work: never a device or a directory */
+        cli_error(err);
         return 1;
     }
+    double voxels = res * res * res;
+    if (voxels > (double)murk_limit(MURK_LIMIT_GRID_VOXELS)) {
+        fprintf(stderr, "murk: --res %.0f gives %.0f voxels, beyond the limit of %llu (%s)\n", res, voxels,
+                (unsigned long long)murk_limit(MURK_LIMIT_GRID_VOXELS), murk_limit_name(MURK_LIMIT_GRID_VOXELS));
+        return 1;
+    }
+    murk_field *f = murk_field_cloud(lo, hi, (int)res, (uint64_t)seed, (float)freq, (int)oct, (float)cov);
+    if (!f) {
+        fprintf(stderr, "murk: could not build the cloud: out of memory\n");
+        return 1;
+    }
+    if (!(murk_field_max(f) > 0.0f))
+        fprintf(stderr, "murk: warning: the cloud is empty (every voxel is 0 at --res %.0f, --coverage %g); the grid "
+                "holds no density\n", res, cov);
     int rc = murk_field_vol_save(out, f, err, sizeof err);
     if (rc)
-        fprintf(stderr, "murk: %s\n", err);
+        cli_error(err);
     else
-        printf("%s: %dx%dx%d cloud over [%g,%g,%g]-[%g,%g,%g], max density %g\n", out, (int)res, (int)res, (int)res,
+        printf("%s: %dx%dx%d cloud over [%g,%g,%g]-[%g,%g,%g], max density %g\n", q(out), (int)res, (int)res, (int)res,
                lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, murk_field_max(f));
     murk_field_free(f);
     return rc ? 1 : 0;

@@ -415,8 +415,10 @@ static int exr_read_image(exr_context_t ctx, exr_io *io, const char *path, murk_
         exr_get_channels(ctx, 0, &chl) != EXR_ERR_SUCCESS || !chl)
         return murk_err_file(err, errlen, path, "EXR header lacks a data window or channel list");
     int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
-    if (!murk_image_size_ok(w, h))
-        return murk_err_file(err, errlen, path, "unsupported EXR size %lldx%lld", (long long)w, (long long)h);
+    /* the header's size against the limit and the file's real size, before any buffer is sized by it
+     * (at least 2 bytes, a HALF channel, per pixel) */
+    if (murk_image_declared_ok(path, "EXR", w, h, 2.0, murk_image_fd_size(io->fd), err, errlen) != 0)
+        return -1;
 
     /* Map file channels to RGB slots: R, G, B if all three exist, else Y into slot 0. */
     int nch = chl->num_channels, found = 0, y_ch = -1;

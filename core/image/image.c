@@ -2,6 +2,8 @@
  * input, the image returned by the readers and its string attributes. */
 #include "image.h"
 #include "error.h"
+#include "file.h"
+#include "limit.h"
 #include "util.h"
 
 #include <errno.h>
@@ -10,6 +12,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* Checks w, h and that 3*w*h floats (and 12*w bytes per row) can be addressed. */
 int murk_image_size_ok(long long w, long long h)
@@ -25,10 +28,30 @@ int murk_image_open_input(const char *path, murk_image *img, char *err, size_t e
     memset(img, 0, sizeof *img);
     if (!path)
         return murk_err_file(err, errlen, "(null)", "no path");
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
-    return fd;
+    uint64_t size;
+    return murk_file_open_regular_fd(path, &size, err, errlen);
+}
+
+int murk_image_declared_ok(const char *path, const char *what, long long w, long long h, double bytes_per_pixel,
+                           uint64_t file_size, char *err, size_t errlen)
+{
+    uint64_t max = murk_limit(MURK_LIMIT_IMAGE_PIXELS);
+    if (!murk_image_size_ok(w, h))
+        return murk_err_file(err, errlen, path, "unsupported %s size %lldx%lld", what, w, h);
+    if ((uint64_t)w * (uint64_t)h > max)
+        return murk_err_file(err, errlen, path, "%s of %lldx%lld pixels exceeds the limit of %llu pixels (%s)", what, w,
+                             h, (unsigned long long)max, murk_limit_name(MURK_LIMIT_IMAGE_PIXELS));
+    double need = (double)w * (double)h * bytes_per_pixel;
+    if (need > MURK_MAX_EXPANSION * (double)file_size + 65536.0)
+        return murk_err_file(err, errlen, path, "header declares %lldx%lld pixels but the file holds only %llu bytes "
+                             "(corrupt or hostile header)", w, h, (unsigned long long)file_size);
+    return 0;
+}
+
+uint64_t murk_image_fd_size(int fd)
+{
+    struct stat st;
+    return fstat(fd, &st) == 0 && st.st_size > 0 ? (uint64_t)st.st_size : 0;
 }
 
 const char *murk_image_meta(const murk_image *img, const char *key)

@@ -7,6 +7,7 @@
 #define MURK_IMAGE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct murk_kv { const char *key, *value; } murk_kv;
 
@@ -27,8 +28,15 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
 const char *murk_image_meta(const murk_image *img, const char *key); /* NULL if absent */
 /* 1 if w x h is positive and 3*w*h floats (and 12*w bytes per row) can be addressed. */
 int murk_image_size_ok(long long w, long long h);
-/* What both readers do first: clears img and opens path for reading. The descriptor, or -1 with err set. */
+/* What both readers do first: clears img and opens path for reading — a regular file only (a FIFO
+ * or device is refused without blocking), within MURK_MAX_FILE_BYTES. The descriptor, or -1 with err set. */
 int murk_image_open_input(const char *path, murk_image *img, char *err, size_t errlen);
+/* What both readers check before allocating for a header's w x h: a size murk can address, at most
+ * MURK_MAX_IMAGE_PIXELS pixels (limit.h), and no more decoded bytes (bytes_per_pixel each) than the
+ * file's size can expand to (MURK_MAX_EXPANSION). 0, or -1 with err "path: ..." naming the problem. */
+int murk_image_declared_ok(const char *path, const char *what, long long w, long long h, double bytes_per_pixel,
+                           uint64_t file_size, char *err, size_t errlen);
+uint64_t murk_image_fd_size(int fd); /* 0 if unknown */
 void murk_image_free(murk_image *img);
 
 #endif

@@ -27,6 +27,8 @@ typedef struct png_job {
     png_bytep *rows;    /* read: row pointers into pix */
     png_uint_32 w, h;
     char msg[200];
+    const char *path;   /* read: for the size check's message */
+    uint64_t file_size; /* read: the file's size */
 } png_job;
 
 static void png_error_cb(png_structp png, png_const_charp msg)
@@ -123,9 +125,19 @@ static int png_decode(png_job *j)
     png_read_info(j->png, j->info);
     j->w = png_get_image_width(j->png, j->info);
     j->h = png_get_image_height(j->png, j->info);
-    if (!murk_image_size_ok(j->w, j->h)) {
-        snprintf(j->msg, sizeof j->msg, "unsupported PNG size %lux%lu", (unsigned long)j->w, (unsigned long)j->h);
-        return -1;
+    {
+        /* before any allocation: the declared size against the limit and against what the file can hold
+         * (bits per pixel as stored; deflate expands at most 1032:1) */
+        char serr[512];
+        double bpp = png_get_bit_depth(j->png, j->info) * png_get_channels(j->png, j->info) / 8.0;
+        if (murk_image_declared_ok(j->path, "PNG", j->w, j->h, bpp, j->file_size, serr, sizeof serr) != 0) {
+            const char *m = strstr(serr, ": ");
+            m = m ? m + 2 : serr;
+            size_t k = strlen(m) < sizeof j->msg ? strlen(m) : sizeof j->msg - 1;
+            memcpy(j->msg, m, k);
+            j->msg[k] = 0;
+            return -1;
+        }
     }
     png_set_expand(j->png); /* palette -> RGB, grey < 8 bits -> 8 bits, tRNS -> alpha */
 #ifdef PNG_READ_SCALE_16_TO_8_SUPPORTED
@@ -162,6 +174,8 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
     int rc = 0, fd = murk_image_open_input(path, img, err, errlen);
     if (fd < 0)
         return -1;
+    j.path = path;
+    j.file_size = murk_image_fd_size(fd);
     j.fp = fdopen(fd, "rb");
     if (!j.fp) {
         close(fd);

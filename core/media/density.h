@@ -30,13 +30,15 @@
 #ifndef MURK_DENSITY_H
 #define MURK_DENSITY_H
 
+#include "limit.h"
 #include <stddef.h>
 #include <stdint.h>
 
 #include "murk/math.h"
 
-/* Largest grid accepted from a file or built procedurally (4 GiB of floats). */
-#define MURK_FIELD_MAX_VOXELS ((uint64_t)1 << 30)
+/* Largest grid accepted from a file or built procedurally: MURK_MAX_GRID_VOXELS (limit.h; 2^27 voxels,
+ * 512 MiB of floats, by default). */
+#define MURK_FIELD_MAX_VOXELS murk_limit(MURK_LIMIT_GRID_VOXELS)
 
 typedef struct murk_field murk_field;
 

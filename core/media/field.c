@@ -29,11 +29,13 @@ murk_field *murk_field_constant(float value)
 
 uint64_t murk_voxel_count(int64_t x, int64_t y, int64_t z)
 {
-    if (x < 1 || y < 1 || z < 1 || x > (int64_t)MURK_FIELD_MAX_VOXELS || y > (int64_t)MURK_FIELD_MAX_VOXELS ||
-        z > (int64_t)MURK_FIELD_MAX_VOXELS)
+    uint64_t max = MURK_FIELD_MAX_VOXELS;
+    if (x < 1 || y < 1 || z < 1 || (uint64_t)x > max || (uint64_t)y > max || (uint64_t)z > max)
         return 0;
-    uint64_t xy = (uint64_t)x * (uint64_t)y; /* < 2^60 */
-    if (xy > MURK_FIELD_MAX_VOXELS || (uint64_t)z > MURK_FIELD_MAX_VOXELS / xy)
+    if ((uint64_t)x > max / (uint64_t)y)
+        return 0;
+    uint64_t xy = (uint64_t)x * (uint64_t)y;
+    if ((uint64_t)z > max / xy)
         return 0;
     return xy * (uint64_t)z;
 }

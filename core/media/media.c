@@ -19,6 +19,7 @@
 #include "media.h"
 #include "density.h"
 #include "host.h"
+#include "limit.h"
 #include "params.h"
 #include "scene.h"
 #include "util.h"
@@ -142,16 +143,23 @@ static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
     if (murk_ycheck_keys(c, "cloud", keys, 7, err, errlen))
         return NULL;
     murk_vec3 lo = murk_v3(-0.5f, -0.5f, -0.5f), hi = murk_v3(0.5f, 0.5f, 0.5f);
-    double seed = 1, freq = 3, oct = 5, cov = 0.5, res = 64;
+    double freq = 3, cov = 0.5;
+    long long seed = 1, oct = 5, res = 64; /* whole numbers: 2.5 is an error, never silently 2 */
     const murk_ynode *k;
     if (((k = murk_ymap_get(c, "min")) && murk_yread_vec3(k, "cloud.min", &lo, err, errlen)) ||
         ((k = murk_ymap_get(c, "max")) && murk_yread_vec3(k, "cloud.max", &hi, err, errlen)) ||
-        ((k = murk_ymap_get(c, "seed")) && murk_yread_range(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
+        ((k = murk_ymap_get(c, "seed")) && murk_yread_int(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
         ((k = murk_ymap_get(c, "frequency")) && murk_yread_range(k, "cloud.frequency", 0.01, 1000, &freq, err, errlen)) ||
-        ((k = murk_ymap_get(c, "octaves")) && murk_yread_range(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
+        ((k = murk_ymap_get(c, "octaves")) && murk_yread_int(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
         ((k = murk_ymap_get(c, "coverage")) && murk_yread_range(k, "cloud.coverage", 0, 1, &cov, err, errlen)) ||
-        ((k = murk_ymap_get(c, "resolution")) && murk_yread_range(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
+        ((k = murk_ymap_get(c, "resolution")) && murk_yread_int(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
         return NULL;
+    if ((double)res * (double)res * (double)res > (double)MURK_FIELD_MAX_VOXELS) {
+        murk_yerr(err, errlen, murk_ymap_get(c, "resolution"), "cloud.resolution %lld gives %.0f voxels, beyond the "
+                  "limit of %llu (%s)", res, (double)res * (double)res * (double)res,
+                  (unsigned long long)MURK_FIELD_MAX_VOXELS, murk_limit_name(MURK_LIMIT_GRID_VOXELS));
+        return NULL;
+    }
     if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
         murk_yerr(err, errlen, c, "cloud: max must exceed min on every axis");
         return NULL;
@@ -359,4 +367,49 @@ void murk_media_free(murk_scene *s)
     free(s->media);
     s->media = NULL;
     s->nmedia = 0;
+}
+
+/* ---- what float arithmetic can carry ------------------------------------------------------- */
+
+int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, murk_vec3 scene_lo, murk_vec3 scene_hi,
+                           char *err, size_t errlen)
+{
+    for (size_t i = 0; i < s->nmedia; i++) {
+        const murk_named_medium *nm = &s->media[i];
+        if (!nm->density || !nm->density->field)
+            continue;
+        murk_vec3 lo, hi;
+        int inf = 0;
+        murk_field_bounds(nm->density->field, &lo, &hi, &inf);
+        const char *over = "its density box";
+        if (inf) { /* a constant density reaches as far as the scene does */
+            lo = scene_lo;
+            hi = scene_hi;
+            over = "the scene";
+        }
+        double ext = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double e = (double)murk_v3_get(hi, a) - (double)murk_v3_get(lo, a);
+            ext += e > 0.0 ? e * e : 0.0;
+        }
+        ext = sqrt(ext);
+        double st = 0.0;
+        for (int k = 0; k < 3; k++)
+            st = fmax(st, (double)nm->data.sigma_a.c[k] + (double)nm->data.sigma_s.c[k]);
+        double dmax = (double)murk_field_max(nm->density->field) * (double)nm->density->factor;
+        double depth = st * dmax * ext;
+        if (!(depth <= MURK_MAX_OPTICAL_DEPTH)) {
+            const murk_ynode *m = media_node ? murk_ymap_get(media_node, nm->name) : NULL, *at = NULL;
+            static const char *const keys[] = {"scale", "sigma_s", "sigma_a", "density"};
+            for (int k = 0; m && !at && k < 4; k++)
+                at = murk_ymap_get(m, keys[k]);
+            murk_ynode here = {.file = s->doc.file, .line = 0, .col = 0};
+            return murk_yerr(err, errlen, at ? at : m ? m : &here,
+                             "medium '%s': optical depth %.3g across %s (extinction %.3g per unit density x max "
+                             "density %.3g x extent %.3g) exceeds %g, the most float arithmetic can track "
+                             "(free flights would fall below the spacing of floats and stop advancing); lower "
+                             "sigma_a, sigma_s or scale", nm->name, depth, over, st, dmax, ext, MURK_MAX_OPTICAL_DEPTH);
+        }
+    }
+    return 0;
 }

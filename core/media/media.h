@@ -8,6 +8,11 @@
 #include "yamldoc.h"
 
 int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+/* Refuses a medium whose optical depth (largest extinction x max density x majorant_factor x extent:
+ * its density box, or the scene's box [scene_lo, scene_hi] for a constant density) exceeds
+ * MURK_MAX_OPTICAL_DEPTH (limit.h): a located error at the medium's scale/sigma key. */
+int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, murk_vec3 scene_lo, murk_vec3 scene_hi,
+                           char *err, size_t errlen);
 
 /* The keys every medium has, read by the core whatever the tracker (sigma_a, sigma_s, scale, g,
  * majorant_factor, majorant_resolution), as a parameter schema; and the two keys read apart from it

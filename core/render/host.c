@@ -92,8 +92,25 @@ static void to_embree(const murk_ray *r, struct RTCRay *er)
     er->flags = 0;
 }
 
+/* Embree asserts (SIGABRT) on a ray it cannot carry: an origin or direction beyond 1.8e18 or not finite,
+ * a NaN or negative tnear, a NaN tfar. Scene coordinates stay within MURK_MAX_COORD (limit.h), but a
+ * path may still wander far out through an unbounded medium: such a ray is not traced (it hits
+ * nothing and nothing occludes it), and murk says so once. */
+static int ray_traceable(const murk_ray *r)
+{
+    const float big = 1e18f;
+    int ok = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
+             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
+    if (!ok)
+        murk_warn_once("a ray beyond the range Embree accepts (origin or direction beyond 1e18, or NaN) was not "
+                       "traced: a path left the scene through an unbounded medium");
+    return ok;
+}
+
 static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
 {
+    if (!ray_traceable(r))
+        return 0;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -110,6 +127,8 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
 
 static int host_occluded(const murk_scene *s, const murk_ray *r)
 {
+    if (!ray_traceable(r))
+        return 0;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay er;

@@ -7,6 +7,7 @@
 #include "scene.h"
 #include "accel.h"
 #include "host.h"
+#include "limit.h"
 #include "media.h"
 #include "obj.h"
 #include "params.h"
@@ -48,6 +49,9 @@ static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t err
             return ERR(c, "render.resolution must be whole numbers");
         s->width = (int)r[0];
         s->height = (int)r[1];
+        if (r[0] * r[1] > (double)murk_limit(MURK_LIMIT_IMAGE_PIXELS)) /* the render's buffers: ~40 bytes a pixel */
+            return ERR(c, "render.resolution %dx%d exceeds the limit of %llu pixels (%s)", s->width, s->height,
+                       (unsigned long long)murk_limit(MURK_LIMIT_IMAGE_PIXELS), murk_limit_name(MURK_LIMIT_IMAGE_PIXELS));
     }
     if ((c = murk_ymap_get(n, "spp"))) {
         if (murk_yread_int(c, "render.spp", 1, 1 << 24, &v, err, errlen))
@@ -258,7 +262,7 @@ static int read_transform(const murk_ynode *n, float m[12], char *err, size_t er
         return -1;
     if ((c = murk_ymap_get(n, "rotate")) && murk_yread_list(c, "transform.rotate", 3, -1e6, 1e6, rot, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "translate")) && murk_yread_list(c, "transform.translate", 3, -1e30, 1e30, tr, err, errlen))
+    if ((c = murk_ymap_get(n, "translate")) && murk_yread_list(c, "transform.translate", 3, -MURK_MAX_COORD, MURK_MAX_COORD, tr, err, errlen))
         return -1;
     if (sc[0] == 0 || sc[1] == 0 || sc[2] == 0)
         return ERR(murk_ymap_get(n, "scale"), "transform.scale must not be 0");
@@ -301,8 +305,12 @@ static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *e
     sh->idx = mesh.idx;
     for (uint32_t i = 0; i < mesh.nverts; i++) {
         float *p = &sh->pos[3 * i], x = p[0], y = p[1], z = p[2];
-        for (int r = 0; r < 3; r++)
+        for (int r = 0; r < 3; r++) {
             p[r] = m[4 * r] * x + m[4 * r + 1] * y + m[4 * r + 2] * z + m[4 * r + 3];
+            if (!(fabsf(p[r]) <= (float)MURK_MAX_COORD)) /* the transformed mesh must fit Embree and float */
+                return ERR(t ? t : f, "mesh: vertex %u lies at %g after the transform, beyond %g, the largest "
+                           "coordinate murk accepts", i + 1, (double)p[r], MURK_MAX_COORD);
+        }
         if (sh->nrm) { /* normals transform by the inverse transpose: R S^-1 for M = R S */
             float *q = &sh->nrm[3 * i], nx = q[0], ny = q[1], nz = q[2];
             murk_vec3 c0 = murk_v3(m[0], m[4], m[8]), c1 = murk_v3(m[1], m[5], m[9]), c2 = murk_v3(m[2], m[6], m[10]);
@@ -360,7 +368,7 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
         double r;
         if (!(c = murk_yrequire(n, "center", "sphere", err, errlen)) || murk_yread_vec3(c, "sphere.center", &sh->center, err, errlen))
             return -1;
-        if (!(c = murk_yrequire(n, "radius", "sphere", err, errlen)) || murk_yread_range(c, "sphere.radius", 1e-6, 1e30, &r, err, errlen))
+        if (!(c = murk_yrequire(n, "radius", "sphere", err, errlen)) || murk_yread_range(c, "sphere.radius", 1e-6, MURK_MAX_COORD, &r, err, errlen))
             return -1;
         sh->radius = (float)r;
     } else if (!strcmp(type, "box")) {
@@ -434,6 +442,28 @@ static int load_shapes(murk_scene *s, const murk_ynode *n, char *err, size_t err
     return 0;
 }
 
+static murk_vec3 vmin3(murk_vec3 a, murk_vec3 b) { return murk_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
+static murk_vec3 vmax3(murk_vec3 a, murk_vec3 b) { return murk_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+
+/* The box around the camera and every shape: how far a constant-density medium can reach. */
+static void scene_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi)
+{
+    *lo = *hi = s->cam_from;
+    for (size_t i = 0; i < s->nshapes; i++) {
+        const murk_shape *sh = &s->shapes[i];
+        if (sh->type == MURK_SHAPE_SPHERE) {
+            murk_vec3 r = murk_v3(sh->radius, sh->radius, sh->radius);
+            *lo = vmin3(*lo, murk_sub(sh->center, r));
+            *hi = vmax3(*hi, murk_add(sh->center, r));
+        }
+        for (uint32_t v = 0; sh->pos && v < sh->nverts; v++) {
+            murk_vec3 p = murk_v3(sh->pos[3 * v], sh->pos[3 * v + 1], sh->pos[3 * v + 2]);
+            *lo = vmin3(*lo, p);
+            *hi = vmax3(*hi, p);
+        }
+    }
+}
+
 static int load_document(murk_scene *s, char *err, size_t errlen)
 {
     static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
@@ -469,7 +499,9 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen))
         return -1;
-    return 0;
+    murk_vec3 lo, hi;
+    scene_bounds(s, &lo, &hi);
+    return murk_media_check_depth(s, murk_ymap_get(root, "media"), lo, hi, err, errlen);
 }
 
 MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen)

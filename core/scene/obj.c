@@ -19,6 +19,8 @@
  * bits whatever locale the application has set. */
 #include "obj.h"
 #include "error.h"
+#include "file.h"
+#include "limit.h"
 
 #include <errno.h>
 #include <locale.h>
@@ -367,8 +369,9 @@ static int parse_face(objparse *o, const char *kw, const char *p, const char *e)
     if (n < 3)
         return fail_at(o, kw, "face has fewer than 3 vertices (%zu)", n);
     size_t ntris = o->nidx / 3 + (n - 2);
-    if (ntris > MAX_COUNT)
-        return fail_at(o, kw, "too many triangles");
+    if (ntris > MAX_COUNT || ntris > murk_limit(MURK_LIMIT_MESH_TRIANGLES))
+        return fail_at(o, kw, "more than %llu triangles (the limit, %s)",
+                       (unsigned long long)murk_limit(MURK_LIMIT_MESH_TRIANGLES), murk_limit_name(MURK_LIMIT_MESH_TRIANGLES));
     if (ntris > SIZE_MAX / 3)
         return oom(o);
     uint32_t *idx = grow(o->idx, &o->capidx, ntris * 3, sizeof *idx);
@@ -472,9 +475,10 @@ int murk_obj_load(const char *path, murk_mesh *mesh, char *err, size_t errlen)
     memset(mesh, 0, sizeof *mesh);
     if (!path)
         return murk_err_file(err, errlen, "(null)", "no path");
-    FILE *f = fopen(path, "rb");
+    uint64_t fsize; /* a regular file within MURK_MAX_FILE_BYTES: never /dev/zero or a FIFO */
+    FILE *f = murk_file_open_regular(path, &fsize, err, errlen);
     if (!f)
-        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+        return -1;
 
     objparse o;
     memset(&o, 0, sizeof o);

@@ -1,5 +1,6 @@
 /* yamldoc.c — libyaml events to a located tree; --set overrides. */
 #include "yamldoc.h"
+#include "file.h"
 #include "error.h"
 #include "util.h"
 
@@ -263,11 +264,10 @@ int murk_ydoc_load_string(murk_ydoc *doc, const char *text, const char *name, ch
 int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errlen)
 {
     memset(doc, 0, sizeof *doc);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+    uint64_t fsize; /* a regular file: a directory, FIFO or device is named as such, never read */
+    FILE *f = murk_file_open_regular(path, &fsize, err, errlen);
+    if (!f)
         return -1;
-    }
     size_t cap = 1 << 16, n = 0;
     unsigned char *buf = murk_xmalloc(cap);
     for (;;) {

@@ -1,6 +1,7 @@
 /* yread.c — typed, range-checked readers of YAML nodes with located errors, shared by the scene,
  * media and texture loaders. */
 #include "yread.h"
+#include "limit.h"
 #include "util.h"
 
 #include <errno.h>
@@ -84,8 +85,16 @@ int murk_yread_list(const murk_ynode *n, const char *what, int len, double lo, d
 int murk_yread_vec3(const murk_ynode *n, const char *what, murk_vec3 *v, char *err, size_t errlen)
 {
     double d[3];
-    if (murk_yread_list(n, what, 3, -1e30, 1e30, d, err, errlen))
-        return -1;
+    if (n->kind != MURK_Y_SEQ || n->n != 3)
+        return ERR(n, "%s must be a list of 3 numbers", what);
+    for (int i = 0; i < 3; i++) {
+        if (murk_yread_number(n->items[i], what, &d[i], err, errlen))
+            return -1;
+        if (fabs(d[i]) > MURK_MAX_COORD) /* positions and vectors alike: the scene must fit Embree and float */
+            return ERR(n->items[i], "%s: %g is beyond %g, the largest coordinate murk accepts (Embree cannot trace "
+                       "rays from beyond 1.8e18 and float arithmetic loses all precision long before)", what, d[i],
+                       MURK_MAX_COORD);
+    }
     *v = murk_v3((float)d[0], (float)d[1], (float)d[2]);
     return 0;
 }

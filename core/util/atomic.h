@@ -1,9 +1,20 @@
-/* atomic.h — writing an output file whole or not at all. Internal to libmurk.
+/* atomic.h — writing output files whole or not at all. Internal to libmurk (the murk_output_* group
+ * calls are exported for the murk command).
  *
  * Every file murk writes (the EXR and its PNG preview, a .vol from `murk grid`) goes through
  * murk_write_atomic: the content is written to PATH.tmp-PID beside the target, flushed to disk and
  * renamed over PATH only when all of it was written. On any failure the temporary is removed and PATH
- * is left as it was, so a failed or interrupted run never leaves a half-written file. */
+ * is left as it was, so a failed or interrupted run never leaves a half-written file.
+ *
+ *  - Only a regular file is ever replaced: when PATH names a directory, a device (/dev/full), a FIFO,
+ *    a socket or a symbolic link, nothing is written and the error says what PATH is.
+ *  - While a temporary exists, SIGINT, SIGTERM and SIGHUP that would end the process (their default
+ *    action) remove it first; where the program installed its own handler (`murk render` finishes
+ *    its image on SIGINT/SIGTERM), that handler runs and the write goes on to its normal end.
+ *  - Several files that belong together (an EXR and its PNG) are written as a group:
+ *    murk_output_begin(), the writes (each leaves its finished temporary), then murk_output_commit()
+ *    renames them all — or, if one write failed, murk_output_abort() removes every temporary. If a
+ *    rename fails half-way, the targets already renamed are removed again: both files or neither. */
 #ifndef MURK_ATOMIC_H
 #define MURK_ATOMIC_H
 
@@ -16,5 +27,14 @@ typedef int (*murk_write_fn)(FILE *fp, const char *tmp, void *user, char *err, s
 
 /* Returns 0, or -1 with err = "path: what went wrong" (fill's own message when fill failed). */
 int murk_write_atomic(const char *path, murk_write_fn fill, void *user, char *err, size_t errlen);
+
+/* 0 if path does not exist or is a regular file murk may replace; else -1 with err naming what it is. */
+int murk_output_check(const char *path, char *err, size_t errlen);
+/* Starts a group: until commit or abort, murk_write_atomic leaves its finished temporaries in place. */
+void murk_output_begin(void);
+/* Renames every temporary of the group over its target (all or none); 0, or -1 with err. Ends the group. */
+int murk_output_commit(char *err, size_t errlen);
+/* Removes every temporary of the group. Ends the group. */
+void murk_output_abort(void);
 
 #endif

@@ -1,26 +1,57 @@
 /* file.c — reading input files whole (the density grid readers). */
 #include "file.h"
 #include "error.h"
+#include "limit.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
+
+static const char *file_kind(mode_t m)
+{
+    return S_ISDIR(m) ? "a directory" : S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device" :
+           S_ISBLK(m) ? "a block device" : S_ISSOCK(m) ? "a socket" : "not a regular file";
+}
+
+int murk_file_open_regular_fd(const char *path, uint64_t *size, char *err, size_t errlen)
+{
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer; cleared again for the reads. */
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0)
+        return murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        murk_err_file(err, errlen, path, "%s, not a regular file", file_kind(st.st_mode));
+        close(fd);
+        return -1;
+    }
+    uint64_t max = murk_limit(MURK_LIMIT_FILE_BYTES);
+    if ((uint64_t)st.st_size > max) {
+        murk_err_file(err, errlen, path, "%llu bytes exceeds the limit of %llu bytes per input file (%s)",
+                      (unsigned long long)st.st_size, (unsigned long long)max, murk_limit_name(MURK_LIMIT_FILE_BYTES));
+        close(fd);
+        return -1;
+    }
+    int fl = fcntl(fd, F_GETFL);
+    if (fl != -1)
+        fcntl(fd, F_SETFL, fl & ~O_NONBLOCK);
+    *size = (uint64_t)st.st_size;
+    return fd;
+}
 
 FILE *murk_file_open_regular(const char *path, uint64_t *size, char *err, size_t errlen)
 {
-    FILE *fp = fopen(path, "rb");
+    int fd = murk_file_open_regular_fd(path, size, err, errlen);
+    if (fd < 0)
+        return NULL;
+    FILE *fp = fdopen(fd, "rb");
     if (!fp) {
-        murk_err_file(err, errlen, path, "%s", strerror(errno));
-        return NULL;
+        murk_err_file(err, errlen, path, "cannot open: %s", strerror(errno));
+        close(fd);
     }
-    struct stat st;
-    if (fstat(fileno(fp), &st) != 0 || !S_ISREG(st.st_mode)) {
-        murk_err_file(err, errlen, path, "not a regular file");
-        fclose(fp);
-        return NULL;
-    }
-    *size = (uint64_t)st.st_size;
     return fp;
 }
 

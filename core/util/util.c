@@ -109,14 +109,75 @@ double murk_now(void)
 
 MURK_API void murk_set_quiet(int q) { quiet = q; }
 
+/* Length of the valid UTF-8 sequence at s (2..4), or 0 if there is none. */
+static size_t utf8_len(const unsigned char *s)
+{
+    size_t n = s[0] >= 0xf0 && s[0] <= 0xf4 ? 4 : s[0] >= 0xe0 ? 3 : s[0] >= 0xc2 && s[0] < 0xe0 ? 2 : 0;
+    for (size_t i = 1; i < n; i++)
+        if ((s[i] & 0xc0) != 0x80)
+            return 0;
+    if ((n == 3 && s[0] == 0xe0 && s[1] < 0xa0) || (n == 3 && s[0] == 0xed && s[1] >= 0xa0) ||
+        (n == 4 && s[0] == 0xf0 && s[1] < 0x90) || (n == 4 && s[0] == 0xf4 && s[1] >= 0x90))
+        return 0; /* overlong, surrogate or beyond U+10FFFF */
+    if (n == 2 && s[0] == 0xc2 && s[1] < 0xa0)
+        return 0; /* C1 control characters U+0080..U+009F */
+    return n;
+}
+
+MURK_API char *murk_printable(char *dst, size_t n, const char *src)
+{
+    if (!dst || n == 0)
+        return dst;
+    const unsigned char *s = (const unsigned char *)(src ? src : "(null)");
+    size_t k = 0;
+    while (*s) {
+        char esc[12];
+        size_t len;
+        const char *out = esc;
+        if (*s >= 0x20 && *s < 0x7f) {
+            out = (const char *)s;
+            len = 1;
+        } else if (*s >= 0x80 && (len = utf8_len(s)) > 0) {
+            out = (const char *)s;
+        } else {
+            if (*s == '\n')
+                len = (size_t)snprintf(esc, sizeof esc, "\\n");
+            else if (*s == '\t')
+                len = (size_t)snprintf(esc, sizeof esc, "\\t");
+            else if (*s == '\r')
+                len = (size_t)snprintf(esc, sizeof esc, "\\r");
+            else if (*s == 0x1b)
+                len = (size_t)snprintf(esc, sizeof esc, "\\e");
+            else if (*s == 0xc2 && s[1] >= 0x80 && s[1] < 0xa0) { /* a C1 control in UTF-8 */
+                len = (size_t)snprintf(esc, sizeof esc, "\\u%04x", s[1]);
+                s++;
+            } else
+                len = (size_t)snprintf(esc, sizeof esc, "\\x%02x", *s);
+            s++;
+            if (k + len >= n)
+                break;
+            memcpy(dst + k, esc, len);
+            k += len;
+            continue;
+        }
+        if (k + len >= n)
+            break;
+        memcpy(dst + k, out, len);
+        k += len;
+        s += len;
+    }
+    dst[k] = 0;
+    return dst;
+}
+
 MURK_API void murk_log(int level, const char *fmt, ...)
 {
     if (quiet && level == MURK_LOG_INFO)
         return;
+    char raw[2048], safe[4096];
     va_list ap;
     va_start(ap, fmt);
-    fputs(level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(raw, sizeof raw, fmt, ap);
     va_end(ap);
+    fprintf(stderr, "%s%s\n", level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", murk_printable(safe, sizeof safe, raw));
 }

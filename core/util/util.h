@@ -21,5 +21,10 @@ char *murk_path_relative_to(const char *path, const char *rel);
 double murk_now(void); /* monotonic seconds */
 void murk_log(int level, const char *fmt, ...) MURK_PRINTF(2, 3);
 void murk_set_quiet(int quiet);
+/* Untrusted text made safe to print on one line: control characters (C0, DEL, C1) and bytes that are
+ * not valid UTF-8 become escapes (\n, \t, \r, \e, \\xNN, \\u00NN); printable ASCII and valid UTF-8 pass.
+ * Writes at most n bytes including the NUL (cut short at a character boundary) and returns dst. The
+ * error formatter, murk_log and the command line pass every echoed name, key and value through it. */
+MURK_API char *murk_printable(char *dst, size_t n, const char *src);
 
 #endif

@@ -24,6 +24,21 @@ const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
                           "scattering events before Russian roulette may end a path"},
 };
 
+/* The plugin's name, for the watchdog's reports. */
+static const char *pt_name(const murk_pt *pt)
+{
+    return pt->media ? (pt->nee ? "volpath_nee" : "volpath") : "path";
+}
+
+/* The watchdog (murk/plugin.h): every loop of li() is bounded — depth by max_depth, boundary crossings
+ * by 1000 per path, shadow-ray segments by 256 — and a path that reaches a bound is ended and reported. */
+static int stuck(const murk_pt *pt)
+{
+    pt->host->warn_once("integrator '%s': a path crossed more than 1000 surfaces or boundaries without "
+                        "scattering (stuck?); it was ended (biased)", pt_name(pt));
+    return 0;
+}
+
 int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int media, void **self, char *err,
                    size_t errlen)
 {
@@ -134,7 +149,10 @@ murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p,
             m = murk_dot(r.d, hit.ng) < 0.0f ? hit.interior : hit.exterior;
         o = offset(hit.p, hit.ng, r.d);
     }
-    return murk_rgb1(0.0f); /* a maze of boundaries: give up (never seen in a real scene) */
+    /* a maze of boundaries: give up (never seen in a real scene); the watchdog says so (murk/plugin.h) */
+    h->warn_once("integrator '%s': a shadow ray crossed more than 256 boundaries; its light was dropped (biased)",
+                 pt_name(pt));
+    return murk_rgb1(0.0f);
 }
 
 /* ---- path state ---------------------------------------------------------------------------- */
@@ -318,7 +336,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         return 0;
     if (murk_dot(wi, v.offset_n) < 0.0f) { /* transmitted: into the medium behind the surface */
         if (++st->crossings > 1000)
-            return 0;
+            return stuck(pt);
         if (pt->media)
             st->medium = v.behind;
         if (bs.eta > 0.0f && isfinite(bs.eta))
@@ -337,7 +355,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
 static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
 {
     if (++st->crossings > 1000)
-        return 0;
+        return stuck(pt);
     if (pt->media)
         st->medium = murk_dot(st->ray.d, hit->ng) < 0.0f ? hit->interior : hit->exterior;
     st->ray = ray_from(offset(hit->p, hit->ng, st->ray.d), st->ray.d);

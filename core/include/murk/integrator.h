@@ -7,7 +7,10 @@
  * its pixel, counted and reported with the integrator's name). The rng is the sample's own stream:
  * draw as many numbers from it as needed, in a deterministic order, so that an image depends only on
  * (scene, seed, spp). Materials and media are called through their vtables (murk/material.h,
- * murk/medium.h); a medium's sample() and transmittance() take rays whose tmax may be INFINITY. */
+ * murk/medium.h); a medium's sample() and transmittance() take rays whose tmax may be INFINITY.
+ * Watchdog (murk/plugin.h): one li() call runs at most MURK_WATCHDOG_ITERATIONS iterations of any of
+ * its loops (bounces, boundary crossings, shadow-ray segments); at the cap it returns what it has
+ * gathered so far (or 0) and reports it with host->warn_once naming the integrator. */
 #ifndef MURK_INTEGRATOR_H
 #define MURK_INTEGRATOR_H
 

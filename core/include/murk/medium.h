@@ -88,7 +88,11 @@ typedef struct murk_medium_vt {
     int (*create)(const murk_host *host, const murk_medium_data *data, const murk_value *params, void **self,
                   char *err, size_t errlen);
     void (*destroy)(void *self);
-    /* Samples a free flight along ray->d from ray->o over (ray->tmin, ray->tmax) into *ev. */
+    /* Samples a free flight along ray->d from ray->o over (ray->tmin, ray->tmax) into *ev.
+     * Watchdog (murk/plugin.h): at most MURK_WATCHDOG_ITERATIONS collisions or majorant cells per
+     * call, every step advancing t by at least one float; at the cap the flight ends the path
+     * (ev->scattered = 1, ev->weight = 0) and the tracker says so with host->warn_once, naming itself
+     * and the medium. transmittance() likewise returns 0 at the cap. murk/tracking.h does all this. */
     void (*sample)(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                    murk_medium_event *ev);
     /* Unbiased per-channel transmittance estimate over (ray->tmin, ray->tmax). */

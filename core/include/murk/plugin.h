@@ -36,7 +36,15 @@
  *   destroy() frees what create() made; called once, on the main thread, after all rendering.
  *   Methods other than create()/destroy() are called from every render thread at once with the same
  *   self: they must not modify the instance (keep per-call state on the stack).
- *   Rays: ray->d is unit length; ray->tmax may be INFINITY (an open ray that leaves the scene). */
+ *   Rays: ray->d is unit length; ray->tmax may be INFINITY (an open ray that leaves the scene).
+ *   Watchdog: one call of a per-sample method (a tracker's sample() or transmittance(), an estimator's
+ *             transmittance(), an integrator's li()) runs at most MURK_WATCHDOG_ITERATIONS iterations
+ *             of any loop (collisions, majorant cells, bounces, boundary crossings). A loop must also
+ *             provably advance: a distance step that does not change a float t moves it to the next
+ *             float. A call that reaches the cap ends its path (weight 0, or transmittance 0), and
+ *             reports it with host->warn_once naming the plugin ("tracker 'delta' (medium 'smoke'):
+ *             ..."), which counts every repeat and prints the total at the end of the run — a render
+ *             that would hang finishes, biased where the cap was hit, and says so. */
 #ifndef MURK_PLUGIN_H
 #define MURK_PLUGIN_H
 
@@ -46,6 +54,11 @@
 
 #define MURK_ABI_MAJOR 1
 #define MURK_ABI_MINOR 3
+
+/* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
+ * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
+ * under a second. */
+#define MURK_WATCHDOG_ITERATIONS 16777216L
 
 #if defined(__GNUC__)
 #define MURK_EXPORT __attribute__((visibility("default")))
