@@ -1,5 +1,5 @@
 /* volpath_nee — volumetric path tracing with next-event estimation at surface and medium vertices:
- * a light sample per vertex with ratio-tracking transmittance through media and boundaries, combined
+ * a light sample per vertex with each medium's transmittance estimate through media and boundaries, combined
  * with BSDF / phase sampling by the power heuristic.
  *
  * Parameters
@@ -18,5 +18,5 @@ static int create(const murk_host *host, const murk_value *params, void **self, 
 static const murk_integrator_vt vt = {sizeof(murk_integrator_vt), MURK_KIND_INTEGRATOR, create, murk_pt_destroy,
                                       murk_pt_li};
 
-MURK_INTEGRATOR_PLUGIN("volpath_nee", "volumetric path tracing, NEE with ratio-tracking transmittance + BSDF/phase sampling, MIS",
+MURK_INTEGRATOR_PLUGIN("volpath_nee", "volumetric path tracing, NEE through media + BSDF/phase sampling, MIS",
                        murk_pt_params, MURK_PT_NPARAMS, &vt)

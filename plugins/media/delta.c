@@ -1,4 +1,4 @@
-/* delta — delta (Woodcock) tracking for free flights, ratio tracking for transmittance.
+/* delta — delta (Woodcock) tracking for free flights, residual ratio tracking for transmittance.
  *
  * Parameters: none of its own. The medium's common keys (density, sigma_a, sigma_s, scale, g,
  * majorant_factor, majorant_resolution) are read by the core.
@@ -13,7 +13,8 @@
  * plain channel average lets them grow without limit), and every channel is reweighted (real:
  * sigma_s,c(x) / (mu q), null: (mu - sigma_t,c(x)) / (mu (1 - q))) — unbiased; murk says so once. Where
  * the majorant fails to bound (majorant_factor < 1), the same weighted choice keeps the estimate
- * unbiased and murk says so once. Shadow rays use ratio tracking with Russian roulette on small
+ * unbiased and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance: the
+ * minorant grid as control) with Russian roulette on small
  * transmittance. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
@@ -68,4 +69,4 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, delta_create, murk_tracker_free,
                                   delta_sample, murk_tracker_transmittance};
 
-MURK_MEDIUM_PLUGIN("delta", "delta tracking free flights, ratio tracking transmittance", NULL, 0, &vt)
+MURK_MEDIUM_PLUGIN("delta", "delta tracking free flights, residual ratio tracking transmittance", NULL, 0, &vt)

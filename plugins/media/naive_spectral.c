@@ -9,7 +9,7 @@
  * weight 0 and pdf ratio 0 (murk/medium.h), so the integrator credits the hero channel with 3x its
  * estimate: unbiased per channel, but every path carries one channel — the colour noise that spectral
  * tracking and spectral MIS remove. Where the majorant fails to bound, weighted collisions keep it
- * unbiased and murk says so once. Shadow rays use ratio tracking (every channel is estimated; only the
+ * unbiased and murk says so once. Shadow rays use residual ratio tracking (every channel is estimated; only the
  * hero's carries weight in the path). */
 #include "murk/medium.h"
 #include "murk/tracking.h"

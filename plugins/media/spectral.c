@@ -14,7 +14,7 @@
  * the path (weight 0), a scattering event weights channel c by sigma_s,c / (mu P_s), a null event by
  * sigma_n,c / (mu P_n). Unbiased for any choice of probabilities that is non-zero wherever the
  * coefficient is; where the majorant fails to bound (sigma_n < 0) the absolute values keep it so, with
- * negative weights, and murk says so once. Shadow rays use ratio tracking. */
+ * negative weights, and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 

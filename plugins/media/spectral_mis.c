@@ -15,7 +15,7 @@
  * together with NEE. A channel whose extinction differs wildly from the hero's no longer blows up the
  * weights as in per-channel delta tracking: some hero samples it well. Where the majorant fails to
  * bound, q_k = |a| / (|a| + |1 - a|) keeps every technique valid (weighted, unbiased) and murk says so
- * once. Shadow rays use ratio tracking. */
+ * once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
