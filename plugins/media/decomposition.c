@@ -44,6 +44,7 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
         return -1;
     m->smin = murk_minf(m->base.sigma_t.c[0], murk_minf(m->base.sigma_t.c[1], m->base.sigma_t.c[2]));
     m->control = (float)p[P_CONTROL].f[0];
+    m->base.plugin = "decomposition";
     if (m->control > 1.0f)
         host->log(MURK_LOG_WARN,
                   "medium '%s': decomposition control %g > 1 can exceed the local density (negative residual): "
@@ -65,15 +66,26 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin;
+    long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
+        if (++steps > MURK_WATCHDOG_ITERATIONS) {
+            murk_tracker_watchdog(&m->base, "a free flight");
+            murk_event_kill(ev, ta);
+            return;
+        }
         float rate_c = m->control * dmin * m->smin; /* control collisions: real in every channel */
         float mu_r = dmax * m->base.smax - rate_c;
         mu_r = murk_maxf(fabsf(mu_r), 1e-3f * murk_maxf(dmax * m->base.smax, rate_c));
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
-        float tc = rate_c > 0.0f ? ta + murk_sample_exp(rng, rate_c) : INFINITY;
+        float tc = rate_c > 0.0f ? murk_advance(ta, murk_sample_exp(rng, rate_c)) : INFINITY;
         for (float t = ta;;) {
-            float tr = mu_r > 0.0f ? t + murk_sample_exp(rng, mu_r) : INFINITY;
+            if (++steps > MURK_WATCHDOG_ITERATIONS) {
+                murk_tracker_watchdog(&m->base, "a free flight");
+                murk_event_kill(ev, t);
+                return;
+            }
+            float tr = mu_r > 0.0f ? murk_advance(t, murk_sample_exp(rng, mu_r)) : INFINITY;
             if (!(tc < tb) && !(tr < tb))
                 break;
             if (tc <= tr) { /* control collision */

@@ -26,6 +26,7 @@ static int delta_create(const murk_host *host, const murk_medium_data *data, con
     murk_tracker *m = murk_tracker_new(host, data, sizeof *m, err, errlen);
     if (!m)
         return -1;
+    m->plugin = "delta";
     if (!m->grey)
         host->log(MURK_LOG_INFO,
                   "medium '%s': delta tracking with chromatic extinction: collisions are chosen with history-aware "
@@ -64,6 +65,8 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
             for (int k = 0; k < 3; k++)
                 ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q);
     }
+    if (c.stopped) /* the watchdog (murk/plugin.h) */
+        murk_event_kill(ev, c.t);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, delta_create, murk_tracker_free,

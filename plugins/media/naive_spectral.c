@@ -18,7 +18,10 @@ static int naive_create(const murk_host *host, const murk_medium_data *data, con
                         char *err, size_t errlen)
 {
     (void)params;
-    return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
+    murk_tracker *m = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen);
+    if (m)
+        m->plugin = "naive_spectral";
+    return (*self = m) ? 0 : -1;
 }
 
 static void naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
@@ -50,6 +53,8 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
         if (a > 1.0f)
             ev->weight.c[hero] *= (1.0f - a) / (1.0f - q);
     }
+    if (c.stopped) /* the watchdog (murk/plugin.h) */
+        murk_event_kill(ev, c.t);
 }
 
 /* every channel's transmittance is estimated; only the hero's carries weight in the path */

@@ -38,6 +38,7 @@ static int spectral_create(const murk_host *host, const murk_medium_data *data, 
     if (!m)
         return -1;
     m->scheme = p[P_PROBABILITIES].choice;
+    m->base.plugin = "spectral";
     *self = m;
     return 0;
 }
@@ -92,6 +93,8 @@ static void spectral_sample(const void *self, const murk_ray *ray, const murk_pa
         for (int k = 0; k < 3; k++)
             ev->weight.c[k] *= sn[k] * sum / (c.mu * pn);
     }
+    if (c.stopped) /* the watchdog (murk/plugin.h) */
+        murk_event_kill(ev, c.t);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, spectral_create, murk_tracker_free,

@@ -23,7 +23,10 @@ static int smis_create(const murk_host *host, const murk_medium_data *data, cons
                        char *err, size_t errlen)
 {
     (void)params;
-    return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
+    murk_tracker *m = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen);
+    if (m)
+        m->plugin = "spectral_mis";
+    return (*self = m) ? 0 : -1;
 }
 
 static void smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
@@ -59,6 +62,8 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
             ev->pdf_ratio.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
         }
     }
+    if (c.stopped) /* the watchdog (murk/plugin.h) */
+        murk_event_kill(ev, c.t);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, smis_create, murk_tracker_free,

@@ -18,7 +18,10 @@ static int tl_create(const murk_host *host, const murk_medium_data *data, const 
                      char *err, size_t errlen)
 {
     (void)params;
-    return (*self = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen)) ? 0 : -1;
+    murk_tracker *m = murk_tracker_new(host, data, sizeof(murk_tracker), err, errlen);
+    if (m)
+        m->plugin = "track_length";
+    return (*self = m) ? 0 : -1;
 }
 
 static murk_rgb tl_estimate(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
@@ -56,6 +59,8 @@ static murk_rgb tl_estimate(const void *self, const murk_ray *ray, const murk_pa
             return murk_rgb1(0.0f);
         }
     }
+    if (c.stopped) /* the watchdog (murk/plugin.h) ended the walk: reported, transmittance 0 */
+        return murk_rgb1(0.0f);
     return T;
 }
 

@@ -20,6 +20,7 @@ typedef struct murk_tracker {
     murk_rgb sigma_t; /* extinction per unit density */
     float smax;       /* its largest channel */
     int grey;         /* 1 if sigma_t is the same in every channel */
+    const char *plugin; /* the tracker's name for the watchdog's reports; set it after murk_tracker_new */
 } murk_tracker;
 
 /* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
@@ -65,6 +66,30 @@ static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb
 
 /* Distance to the next event of a Poisson process of rate mu > 0. */
 static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-murk_rng_float(rng)) / mu; }
+
+/* t + step, but at least the next float above t: a loop that steps t always advances (the watchdog
+ * contract, murk/plugin.h), even where a step is below the float spacing of t. */
+static inline float murk_advance(float t, float step)
+{
+    float n = t + step;
+    return n > t ? n : nextafterf(t, INFINITY);
+}
+
+/* The watchdog's report for a tracker (murk/plugin.h): once per run and message, counted. */
+static inline void murk_tracker_watchdog(const murk_tracker *t, const char *what)
+{
+    t->host->warn_once("tracker '%s' (medium '%s'): %s exceeded %ld iterations (MURK_WATCHDOG_ITERATIONS); "
+                       "the path was ended (biased)", t->plugin ? t->plugin : "?", t->d->name, what,
+                       MURK_WATCHDOG_ITERATIONS);
+}
+
+/* Ends a path at a flight the watchdog stopped: weight 0, "scattered" at t. */
+static inline void murk_event_kill(murk_medium_event *ev, float t)
+{
+    ev->weight = murk_rgb1(0.0f);
+    ev->scattered = 1;
+    ev->t = t;
+}
 
 /* Probability of taking the "real" branch of a collision whose real and null weights (each relative to
  * the majorant, real + null = 1) are a and b, for ONE channel (grey extinction, or a tracker that
@@ -113,6 +138,8 @@ typedef struct murk_collisions {
     const murk_ray *ray;
     murk_majorant_walk walk;
     float sigma, t, tb, mu, dmin;
+    long steps;  /* collisions and cells so far */
+    int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
 } murk_collisions;
 
 static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *tr, const murk_ray *ray, float sigma)
@@ -123,16 +150,25 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->t = c->tb = ray->tmin;
     c->mu = 0.0f;
     c->dmin = 0.0f;
+    c->steps = 0;
+    c->stopped = 0;
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
 }
 
 /* The next tentative collision: its distance *t and the density *dens there; c->mu is the majorant rate
- * it was drawn with. Returns 0 when the ray's segment is used up. */
+ * it was drawn with. Returns 0 when the ray's segment is used up — or when the watchdog stopped it
+ * (c->stopped, reported once; the caller ends the path with murk_event_kill). Every iteration advances
+ * t by at least one float or moves to the next cell, so the loop ends. */
 static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
 {
     for (;;) {
+        if (++c->steps > MURK_WATCHDOG_ITERATIONS) {
+            c->stopped = 1;
+            murk_tracker_watchdog(c->tr, "a free flight");
+            return 0;
+        }
         if (c->mu > 0.0f) {
-            c->t += murk_sample_exp(rng, c->mu);
+            c->t = murk_advance(c->t, murk_sample_exp(rng, c->mu));
             if (c->t < c->tb) {
                 *t = c->t;
                 *dens = c->tr->host->density(c->tr->d->density, murk_madd(c->ray->o, c->ray->d, c->t));
@@ -178,7 +214,7 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
         if (!(mu > 0.0f))
             continue;
         for (float t = ta;;) {
-            t += murk_sample_exp(rng, mu);
+            t = murk_advance(t, murk_sample_exp(rng, mu));
             if (!(t < tb))
                 break;
             murk_vec3 p = murk_madd(ray->o, ray->d, t);
@@ -191,9 +227,9 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
                     return murk_rgb1(0.0f);
                 T = murk_rgb_scale(T, 1.0f / tm);
             }
-            if (++steps > 100000000L) {
-                h->warn_once("medium '%s': ratio tracking gave up after 1e8 steps (transmittance set to 0: biased)",
-                             d->name);
+            if (++steps > MURK_WATCHDOG_ITERATIONS) {
+                h->warn_once("medium '%s': ratio tracking exceeded %ld iterations (MURK_WATCHDOG_ITERATIONS); "
+                             "transmittance set to 0 (biased)", d->name, MURK_WATCHDOG_ITERATIONS);
                 return murk_rgb1(0.0f);
             }
         }
