@@ -26,18 +26,12 @@
  * (and spectral's three probability schemes); decomposition control 0, 0.1, 0.5, 1, 2 and majorant
  * factor 4 against the closed form and against control 0; majorant factor 0.5 (weighted collisions)
  * for every tracker; Henyey-Greenstein sampling against phase_eval (chi-square). */
-#include "testutil.h"
+#include "mediatest.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-#include "density.h"
-#include "host.h"
-#include "media.h"
-#include "scene.h"
 
 #define NBINS 8
 
@@ -45,14 +39,8 @@ static int nfail; /* checks that failed in the current test (all are printed bef
 
 /* ---- scenes ----------------------------------------------------------------------------------- */
 
-typedef struct mspec {
-    const char *label; /* the medium's name in the scene */
-    const char *keys;  /* its type and own keys, e.g. "type: decomposition, control: 0.5" */
-    int weighted;      /* 1: a bound fails on purpose (weighted collisions): no resolution demanded */
-} mspec;
-
 /* Every tracker (and spectral's three probability schemes) with its default parameters. */
-static const mspec ALL_TRACKERS[] = {
+static const mt_spec ALL_TRACKERS[] = {
     {"delta", "type: delta", 0},
     {"decomposition", "type: decomposition", 0},
     {"spectral", "type: spectral", 0},
@@ -63,115 +51,11 @@ static const mspec ALL_TRACKERS[] = {
 };
 #define NTRACKERS ((int)(sizeof ALL_TRACKERS / sizeof ALL_TRACKERS[0]))
 
-/* Writes a scene with one medium per spec, each with the common keys (density, sigmas, ...), and
- * loads it. */
-static murk_scene *load_media(const char *file, const char *common, const mspec *ms, int n)
-{
-    static char text[16384];
-    size_t k = (size_t)snprintf(text, sizeof text, "murk: 1\nmedia:\n");
-    for (int i = 0; i < n; i++)
-        k += (size_t)snprintf(text + k, sizeof text - k, "  %s: { %s, %s }\n", ms[i].label, ms[i].keys, common);
-    snprintf(text + k, sizeof text - k, "shapes: []\n");
-    char err[2048];
-    murk_scene *s = murk_scene_load(write_tmp(file, text), NULL, 0, err, sizeof err);
-    if (!s)
-        fail_msg("scene load failed: %s\n%s", err, text);
-    assert_int_equal((int)s->nmedia, n);
-    return s;
-}
-
-/* Voxels at the centres of a res grid over [lo, hi], f(x, y, z) at each centre; saved as .vol. */
-static const char *save_grid(const char *name, const int res[3], murk_vec3 lo, murk_vec3 hi,
-                             float (*f)(float, float, float))
-{
-    size_t n = (size_t)res[0] * res[1] * res[2];
-    float *v = malloc(n * sizeof *v);
-    assert_non_null(v);
-    for (int z = 0; z < res[2]; z++)
-        for (int y = 0; y < res[1]; y++)
-            for (int x = 0; x < res[0]; x++) {
-                float cx = lo.x + (hi.x - lo.x) * ((float)x + 0.5f) / (float)res[0];
-                float cy = lo.y + (hi.y - lo.y) * ((float)y + 0.5f) / (float)res[1];
-                float cz = lo.z + (hi.z - lo.z) * ((float)z + 0.5f) / (float)res[2];
-                v[((size_t)z * res[1] + y) * res[0] + x] = f(cx, cy, cz);
-            }
-    murk_field *fld = murk_field_from_voxels(res, lo, hi, v);
-    assert_non_null(fld);
-    free(v);
-    static char path[4][512];
-    static int next;
-    char *p = path[next++ & 3];
-    snprintf(p, sizeof path[0], "%s/%s", tmp_dir(), name);
-    char err[512];
-    if (murk_field_vol_save(p, fld, err, sizeof err) != 0)
-        fail_msg("%s", err);
-    murk_field_free(fld);
-    return p;
-}
-
-/* Linear ramp along z: 0.2 + 1.1 z on [0,1]^3. Trilinear interpolation reproduces it exactly between
- * the first and last centres; in the two clamped half-cells the integral gains and loses b h^2 / 2
- * (h = half a cell), which cancel: int_0^1 density dz = 0.2 + 1.1 / 2 = 0.75 exactly. */
-static float ramp_f(float x, float y, float z)
-{
-    (void)x, (void)y;
-    return 0.2f + 1.1f * z;
-}
-
-/* A smooth 3-D pattern in [0.05, 0.31] on [-1,1]^3 (minimum > 0, so decomposition's minorant grid is
- * non-trivial). */
-static float sinus_f(float x, float y, float z)
-{
-    return 0.18f + 0.13f * sinf(3.0f * x + 1.0f) * sinf(2.5f * y + 0.3f) * cosf(2.0f * z);
-}
-
-/* ---- the reference: optical depth of the interpolated field ----------------------------------- */
-
-/* D at the NBINS + 1 bin edges of [tmin, tmax] (midpoint rule, 4096 steps per bin) on the field as the
- * core interpolates it: for a grid, the .vol file loaded again here and evaluated with murk_field_eval
- * (independent of the media plumbing the trackers go through); for a constant, the medium's field. */
-static void optical_depths(const murk_medium *m, const char *grid, const murk_ray *ray, double D[NBINS + 1])
-{
-    murk_field *f = NULL;
-    if (grid) {
-        char err[512];
-        f = murk_field_vol_load(grid, err, sizeof err);
-        if (!f)
-            fail_msg("%s", err);
-    }
-    const int sub = 4096;
-    double h = ((double)ray->tmax - ray->tmin) / (NBINS * sub), acc = 0.0;
-    D[0] = 0.0;
-    for (int b = 0; b < NBINS; b++) {
-        for (int i = 0; i < sub; i++) {
-            double t = ray->tmin + h * ((double)(b * sub + i) + 0.5);
-            murk_vec3 p = murk_madd(ray->o, ray->d, (float)t);
-            acc += h * (f ? murk_field_eval(f, p) : murk_media_density(m->data->density, p));
-        }
-        D[b + 1] = acc;
-    }
-    murk_field_free(f);
-}
-
 /* ---- estimation ------------------------------------------------------------------------------- */
-
-typedef struct acc3 { double s[3], s2[3]; } acc3;
-
-static void acc_add(acc3 *a, int c, double x)
-{
-    a->s[c] += x;
-    a->s2[c] += x * x;
-}
-static double acc_mean(const acc3 *a, int c, long n) { return a->s[c] / (double)n; }
-static double acc_se(const acc3 *a, int c, long n)
-{
-    double m = a->s[c] / (double)n, v = a->s2[c] / (double)n - m * m;
-    return sqrt(fmax(v, 0.0) * (double)n / (double)(n - 1) / (double)n);
-}
 
 typedef struct stats {
     long n, nonfinite, bad_t;
-    acc3 T, pass, scat, bin[NBINS];
+    mt_acc T, pass, scat, bin[NBINS];
 } stats;
 
 /* n calls of transmittance() and n of sample() on one ray, heroes uniform, one fixed-seed stream. */
@@ -185,9 +69,9 @@ static void run_tracker(const murk_medium *m, const murk_ray *ray, long n, uint6
     ctx.beta = murk_rgb1(1.0f);
     double width = ((double)ray->tmax - ray->tmin) / NBINS;
     for (long i = 0; i < n; i++) {
-        ctx.hero = (int)(murk_rng_float(&rng) * 3.0f);
+        ctx.hero = mt_hero(&rng);
         murk_rgb T = m->vt->transmittance(m->self, ray, &ctx, &rng);
-        ctx.hero = (int)(murk_rng_float(&rng) * 3.0f);
+        ctx.hero = mt_hero(&rng);
         murk_medium_event ev;
         m->vt->sample(m->self, ray, &ctx, &rng, &ev);
         double mp = ((double)ev.pdf_ratio.c[0] + ev.pdf_ratio.c[1] + ev.pdf_ratio.c[2]) / 3.0;
@@ -198,40 +82,30 @@ static void run_tracker(const murk_medium *m, const murk_ray *ray, long n, uint6
         int b = ev.scattered ? (int)(((double)ev.t - ray->tmin) / width) : -1;
         if (b >= NBINS)
             b = NBINS - 1;
+        double xT[3], xp[3], xs[3], xb[NBINS][3];
         for (int c = 0; c < 3; c++) {
             double x = mp > 0.0 ? ev.weight.c[c] / mp : 0.0;
-            acc_add(&st->T, c, T.c[c]);
-            acc_add(&st->pass, c, ev.scattered ? 0.0 : x);
-            acc_add(&st->scat, c, ev.scattered ? x : 0.0);
+            xT[c] = T.c[c];
+            xp[c] = ev.scattered ? 0.0 : x;
+            xs[c] = ev.scattered ? x : 0.0;
             for (int k = 0; k < NBINS; k++)
-                acc_add(&st->bin[k], c, k == b ? x : 0.0);
+                xb[k][c] = k == b ? x : 0.0;
         }
+        mt_acc_add(&st->T, xT);
+        mt_acc_add(&st->pass, xp);
+        mt_acc_add(&st->scat, xs);
+        for (int k = 0; k < NBINS; k++)
+            mt_acc_add(&st->bin[k], xb[k]);
     }
 }
 
-/* Checks one per-channel figure against its expectation: |mean - expect| <= 4 se (plus float
- * rounding) in every channel. With power = 1 it also asserts the figure's resolution: in its
- * best-measured channel a 3% error of the figure must amount to at least 5 se, so that it would fail
- * the 4 se bound with probability >= 84% (and a bias common to all trackers and figures, such as a
- * wrong density, fails many of them). Prints one line; "3%=" is that resolution in se. */
-static void check3(const char *label, const char *what, const acc3 *a, long n, const double expect[3], int power)
+/* mt_check of one figure (|mean - expect| <= 4 se, and with power the 3% resolution; a bias common to
+ * all trackers and figures, such as a wrong density, fails many of them). */
+static void check3(const char *label, const char *what, const mt_acc *a, const double expect[3], int power)
 {
-    char line[512];
-    size_t k = (size_t)snprintf(line, sizeof line, "  %-22s %-8s", label, what);
-    int bad = 0;
-    double res = 0.0;
-    for (int c = 0; c < 3; c++) {
-        double m = acc_mean(a, c, n), se = acc_se(a, c, n), e = expect[c];
-        double tol = 4.0 * se + 1e-5 * fabs(e) + 1e-7;
-        if (!(fabs(m - e) <= tol))
-            bad = 1;
-        res = fmax(res, se > 0.0 ? 0.03 * fabs(e) / se : INFINITY);
-        k += (size_t)snprintf(line + k, sizeof line - k, "  %.5f+-%.5f (%.5f, z %+.1f)", m, se, e,
-                              se > 0 ? (m - e) / se : 0.0);
-    }
-    int weak = power && res < 5.0;
-    printf("%s  3%%=%.1f se%s%s\n", line, res, bad ? "  <-- FAIL" : "", weak ? "  <-- too noisy to see a 3% error" : "");
-    nfail += bad + weak;
+    char head[128];
+    snprintf(head, sizeof head, "  %-22s %-8s", label, what);
+    nfail += mt_check(head, a, expect, 1e-5, power, "");
 }
 
 typedef struct config {
@@ -246,11 +120,13 @@ typedef struct config {
  * per bin and in all against the closed forms; the 3% resolution is asserted for T, pass-through and
  * all collisions unless the medium is marked weighted (a failed bound makes weighted collisions
  * noisier by design). Returns the stats of each medium in out (if non-NULL). */
-static void check_scene(const murk_scene *s, const mspec *ms, const config *cfg, long n, stats *out)
+static void check_scene(const murk_scene *s, const mt_spec *ms, const config *cfg, long n, stats *out)
 {
     printf("%s\n", cfg->name);
+    /* the reference: D at the bin edges, 4096 midpoint steps per bin, on the field as the core
+     * interpolates it */
     double D[NBINS + 1];
-    optical_depths(&s->media[0].m, cfg->grid, &cfg->ray, D);
+    mt_depths(&s->media[0].m, cfg->grid, &cfg->ray, NBINS, 4096, D);
     if (cfg->D_exact >= 0) {
         printf("  optical depth: quadrature %.6f, closed form %.6f\n", D[NBINS], cfg->D_exact);
         assert_true(fabs(D[NBINS] - cfg->D_exact) < 1e-4 * cfg->D_exact);
@@ -268,40 +144,32 @@ static void check_scene(const murk_scene *s, const mspec *ms, const config *cfg,
     for (size_t i = 0; i < s->nmedia; i++) {
         const murk_medium *m = &s->media[i].m;
         stats st;
-        struct timespec t0, t1;
-        clock_gettime(CLOCK_MONOTONIC, &t0);
+        double t0 = mt_seconds();
         run_tracker(m, &cfg->ray, n, 1000 + i, &st);
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        printf("  %-22s %ld calls each of transmittance() and sample() in %.2f s\n", m->name, n,
-               (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+        printf("  %-22s %ld calls each of transmittance() and sample() in %.2f s\n", m->name, n, mt_seconds() - t0);
         if (st.nonfinite || st.bad_t) {
             printf("  %-22s %ld non-finite results, %ld events outside the segment  <-- FAIL\n", m->name,
                    st.nonfinite, st.bad_t);
             nfail++;
         }
         int power = !ms[i].weighted;
-        check3(m->name, "T", &st.T, n, T, power);
-        check3(m->name, "pass", &st.pass, n, T, power);
-        check3(m->name, "scatter", &st.scat, n, S, power);
+        check3(m->name, "T", &st.T, T, power);
+        check3(m->name, "pass", &st.pass, T, power);
+        check3(m->name, "scatter", &st.scat, S, power);
         for (int b = 0; b < NBINS; b++) {
             char w[16];
             snprintf(w, sizeof w, "bin %d", b);
-            check3(m->name, w, &st.bin[b], n, B[b], 0);
+            check3(m->name, w, &st.bin[b], B[b], 0);
         }
         if (out)
             out[i] = st;
     }
 }
 
-static const double GREY_SA[3] = {0.3, 0.3, 0.3}, GREY_SS[3] = {0.9, 0.9, 0.9};
-static const double CHROMA_SA[3] = {0.2, 1.0, 3.0}, CHROMA_SS[3] = {1.0, 0.5, 0.1};
-#define GREY_KEYS "sigma_a: 0.3, sigma_s: 0.9"
-#define CHROMA_KEYS "sigma_a: [0.2, 1, 3], sigma_s: [1, 0.5, 0.1]"
-
 static void set_sigma(config *cfg, int chroma)
 {
-    memcpy(cfg->sa, chroma ? CHROMA_SA : GREY_SA, sizeof cfg->sa);
-    memcpy(cfg->ss, chroma ? CHROMA_SS : GREY_SS, sizeof cfg->ss);
+    memcpy(cfg->sa, mt_sigma_a[chroma], sizeof cfg->sa);
+    memcpy(cfg->ss, mt_sigma_s[chroma], sizeof cfg->ss);
 }
 
 static void scale_sigma(config *cfg, double scale)
@@ -328,8 +196,8 @@ static void test_constant(void **state)
     nfail = 0;
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[256];
-        snprintf(common, sizeof common, "density: { constant: 0.5 }, %s", chroma ? CHROMA_KEYS : GREY_KEYS);
-        murk_scene *s = load_media("constant.yaml", common, ALL_TRACKERS, NTRACKERS);
+        snprintf(common, sizeof common, "density: { constant: 0.5 }, %s", mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("constant.yaml", common, "", ALL_TRACKERS, NTRACKERS);
         config cfg = {chroma ? "constant density, chromatic" : "constant density, grey",
                       {murk_v3(0.1f, -0.2f, 0.3f), murk_normalize(murk_v3(1, 2, -2)), 0.0f, 1.5f}, {0}, {0}, 0.75, NULL};
         set_sigma(&cfg, chroma);
@@ -345,14 +213,13 @@ static void test_ramp(void **state)
 {
     (void)state;
     nfail = 0;
-    const char *grid = save_grid("ramp.vol", (int[]){4, 4, 16}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), ramp_f);
-    murk_vec3 d = murk_normalize(murk_v3(0.2f, 0.1f, 1.0f));
+    mt_case rc = mt_ramp_case();
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[1024];
-        snprintf(common, sizeof common, "density: { grid: %s }, %s", grid, chroma ? CHROMA_KEYS : GREY_KEYS);
-        murk_scene *s = load_media("ramp.yaml", common, ALL_TRACKERS, NTRACKERS);
+        snprintf(common, sizeof common, "density: { grid: %s }, %s", rc.grid, mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("ramp.yaml", common, "", ALL_TRACKERS, NTRACKERS);
         config cfg = {chroma ? "linear ramp, chromatic" : "linear ramp, grey",
-                      {murk_v3(0.3f, 0.4f, -0.5f), d, 0.0f, 2.5f}, {0}, {0}, 0.75 / d.z, grid};
+                      rc.ray, {0}, {0}, rc.D, rc.grid};
         set_sigma(&cfg, chroma);
         check_scene(s, ALL_TRACKERS, &cfg, N_MAIN, NULL);
         murk_scene_free(s);
@@ -366,14 +233,13 @@ static void test_sinus(void **state)
 {
     (void)state;
     nfail = 0;
-    const char *grid = save_grid("sinus.vol", (int[]){16, 16, 16}, murk_v3(-1, -1, -1), murk_v3(1, 1, 1), sinus_f);
+    mt_case sc = mt_sinus_case();
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[1024];
-        snprintf(common, sizeof common, "density: { grid: %s }, %s", grid, chroma ? CHROMA_KEYS : GREY_KEYS);
-        murk_scene *s = load_media("sinus.yaml", common, ALL_TRACKERS, NTRACKERS);
+        snprintf(common, sizeof common, "density: { grid: %s }, %s", sc.grid, mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("sinus.yaml", common, "", ALL_TRACKERS, NTRACKERS);
         config cfg = {chroma ? "sinusoid, chromatic" : "sinusoid, grey",
-                      {murk_v3(-1.5f, -1.2f, -1.4f), murk_normalize(murk_v3(1.0f, 0.8f, 0.9f)), 1.0f, 4.0f},
-                      {0}, {0}, -1.0, grid};
+                      sc.ray, {0}, {0}, sc.D, sc.grid};
         set_sigma(&cfg, chroma);
         check_scene(s, ALL_TRACKERS, &cfg, N_MAIN, NULL);
         murk_scene_free(s);
@@ -386,15 +252,15 @@ static void test_sinus(void **state)
 /* Two-sample comparison of every figure of b against a (|difference| <= 4 combined se). */
 static void compare_stats(const char *la, const stats *a, const char *lb, const stats *b)
 {
-    const acc3 *pa[3] = {&a->T, &a->pass, &a->scat}, *pb[3] = {&b->T, &b->pass, &b->scat};
+    const mt_acc *pa[3] = {&a->T, &a->pass, &a->scat}, *pb[3] = {&b->T, &b->pass, &b->scat};
     static const char *const what[3] = {"T", "pass", "scatter"};
     for (int q = 0; q < 3; q++) {
         char line[512];
         size_t k = (size_t)snprintf(line, sizeof line, "  %s vs %s %-8s", lb, la, what[q]);
         int bad = 0;
         for (int c = 0; c < 3; c++) {
-            double d = acc_mean(pb[q], c, b->n) - acc_mean(pa[q], c, a->n);
-            double se = sqrt(pow(acc_se(pa[q], c, a->n), 2) + pow(acc_se(pb[q], c, b->n), 2));
+            double d = mt_mean(pb[q], c) - mt_mean(pa[q], c);
+            double se = sqrt(pow(mt_se(pa[q], c), 2) + pow(mt_se(pb[q], c), 2));
             if (!(fabs(d) <= 4.0 * se + 1e-6))
                 bad = 1;
             k += (size_t)snprintf(line + k, sizeof line - k, "  diff %+.5f+-%.5f", d, se);
@@ -408,7 +274,7 @@ static void test_decomposition_control(void **state)
 {
     (void)state;
     nfail = 0;
-    static const mspec ms[] = {
+    static const mt_spec ms[] = {
         {"control_0", "type: decomposition, control: 0", 0},
         {"control_0.1", "type: decomposition, control: 0.1", 0},
         {"control_0.5", "type: decomposition, control: 0.5", 0},
@@ -422,17 +288,16 @@ static void test_decomposition_control(void **state)
         {"naive_majorant_4", "type: naive_spectral, majorant_factor: 4", 0},
     };
     int n = (int)(sizeof ms / sizeof ms[0]);
-    const char *grid = save_grid("sinus.vol", (int[]){16, 16, 16}, murk_v3(-1, -1, -1), murk_v3(1, 1, 1), sinus_f);
+    mt_case sc = mt_sinus_case();
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[1024];
-        snprintf(common, sizeof common, "density: { grid: %s }, %s", grid, chroma ? CHROMA_KEYS : GREY_KEYS);
+        snprintf(common, sizeof common, "density: { grid: %s }, %s", sc.grid, mt_sigma_keys(chroma));
         /* the other trackers' majorant_factor 4 only with chromatic sigma (grey adds little) */
         int nm = chroma ? n : 7;
-        murk_scene *s = load_media("control.yaml", common, ms, nm);
+        murk_scene *s = mt_load_media("control.yaml", common, "", ms, nm);
         config cfg = {chroma ? "decomposition control / majorant factor, sinusoid, chromatic"
                              : "decomposition control / majorant factor, sinusoid, grey",
-                      {murk_v3(-1.5f, -1.2f, -1.4f), murk_normalize(murk_v3(1.0f, 0.8f, 0.9f)), 1.0f, 4.0f},
-                      {0}, {0}, -1.0, grid};
+                      sc.ray, {0}, {0}, sc.D, sc.grid};
         set_sigma(&cfg, chroma);
         stats st[16];
         check_scene(s, ms, &cfg, N_CONTROL, st);
@@ -443,8 +308,8 @@ static void test_decomposition_control(void **state)
     /* the same on a constant density, where control 1 takes every collision in closed form */
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[256];
-        snprintf(common, sizeof common, "density: { constant: 0.5 }, %s", chroma ? CHROMA_KEYS : GREY_KEYS);
-        murk_scene *s = load_media("control_c.yaml", common, ms, 7);
+        snprintf(common, sizeof common, "density: { constant: 0.5 }, %s", mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("control_c.yaml", common, "", ms, 7);
         config cfg = {chroma ? "decomposition control, constant, chromatic" : "decomposition control, constant, grey",
                       {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, 1.5f}, {0}, {0}, 0.75, NULL};
         set_sigma(&cfg, chroma);
@@ -465,7 +330,7 @@ static void test_majorant_half(void **state)
 {
     (void)state;
     nfail = 0;
-    static const mspec ms[] = {
+    static const mt_spec ms[] = {
         {"delta", "type: delta, majorant_factor: 0.5", 1},
         {"decomposition", "type: decomposition, majorant_factor: 0.5", 1},
         {"decomposition_c0", "type: decomposition, control: 0, majorant_factor: 0.5", 1},
@@ -475,14 +340,13 @@ static void test_majorant_half(void **state)
         {"naive_spectral", "type: naive_spectral, majorant_factor: 0.5", 1},
     };
     int n = (int)(sizeof ms / sizeof ms[0]);
-    const char *grid = save_grid("sinus.vol", (int[]){16, 16, 16}, murk_v3(-1, -1, -1), murk_v3(1, 1, 1), sinus_f);
+    mt_case sc = mt_sinus_case();
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[1024];
-        snprintf(common, sizeof common, "density: { grid: %s }, scale: 0.5, %s", grid, chroma ? CHROMA_KEYS : GREY_KEYS);
-        murk_scene *s = load_media("half.yaml", common, ms, n);
+        snprintf(common, sizeof common, "density: { grid: %s }, scale: 0.5, %s", sc.grid, mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("half.yaml", common, "", ms, n);
         config cfg = {chroma ? "majorant_factor 0.5, sinusoid, chromatic" : "majorant_factor 0.5, sinusoid, grey",
-                      {murk_v3(-1.5f, -1.2f, -1.4f), murk_normalize(murk_v3(1.0f, 0.8f, 0.9f)), 1.0f, 4.0f},
-                      {0}, {0}, -1.0, grid};
+                      sc.ray, {0}, {0}, sc.D, sc.grid};
         set_sigma(&cfg, chroma);
         scale_sigma(&cfg, 0.5);
         check_scene(s, ms, &cfg, N_HALF, NULL);

@@ -27,15 +27,6 @@
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-#ifndef assert_contains
-#define assert_contains(hay, needle)                                                                   \
-    do {                                                                                               \
-        const char *h_ = (hay), *n_ = (needle);                                                        \
-        if (!h_ || !strstr(h_, n_))                                                                    \
-            fail_msg("expected \"%s\" in:\n%s", n_, h_ ? h_ : "(null)");                               \
-    } while (0)
-#endif
-
 /* A fresh folder under the test's temporary folder. */
 static const char *fresh_dir(const char *name)
 {

@@ -15,13 +15,6 @@
 
 #include "murk/murk.h"
 
-#define assert_contains(hay, needle)                                                                   \
-    do {                                                                                               \
-        const char *h_ = (hay), *n_ = (needle);                                                        \
-        if (!h_ || !strstr(h_, n_))                                                                    \
-            fail_msg("expected \"%s\" in:\n%s", n_, h_ ? h_ : "(null)");                               \
-    } while (0)
-
 typedef struct bad_scene {
     const char *name;
     const char *file; /* under tests/fixtures/scenes/, or NULL: `text` written to the temp folder */

@@ -25,28 +25,17 @@
  *   image          cornell_smoke (32x32) with every unbiased estimator against ratio: block-wise z-test
  *                  (img_stack_agree); raymarch with a coarse step must DIFFER (the comparison sees its
  *                  bias). */
-#include "testutil.h"
+#include "mediatest.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-
-#include "density.h"
-#include "host.h"
-#include "media.h"
-#include "scene.h"
 
 static int nfail;
 
-typedef struct espec {
-    const char *label;
-    const char *keys; /* the medium's estimator and extra keys */
-    int weighted;     /* a bound fails on purpose: no resolution demanded */
-} espec;
-
-static const espec UNBIASED[] = {
+/* media: `type: delta, ` and the estimator with its extra keys; weighted: a bound fails on purpose */
+static const mt_spec UNBIASED[] = {
     {"ratio", "transmittance: ratio", 0},
     {"residual_ratio", "transmittance: residual_ratio", 0},
     {"residual_ratio_c0.5", "transmittance: { type: residual_ratio, control: 0.5 }", 0},
@@ -58,150 +47,52 @@ static const espec UNBIASED[] = {
 };
 #define NUNBIASED ((int)(sizeof UNBIASED / sizeof UNBIASED[0]))
 
-static murk_scene *load_media(const char *file, const char *common, const espec *es, int n)
+static murk_scene *load_media(const char *file, const char *common, const mt_spec *es, int n)
 {
-    static char text[16384];
-    size_t k = (size_t)snprintf(text, sizeof text, "murk: 1\nmedia:\n");
-    for (int i = 0; i < n; i++)
-        k += (size_t)snprintf(text + k, sizeof text - k, "  %s: { type: delta, %s, %s }\n", es[i].label, es[i].keys,
-                              common);
-    snprintf(text + k, sizeof text - k, "shapes: []\n");
-    char err[2048];
-    murk_scene *s = murk_scene_load(write_tmp(file, text), NULL, 0, err, sizeof err);
-    if (!s)
-        fail_msg("scene load failed: %s\n%s", err, text);
-    assert_int_equal((int)s->nmedia, n);
+    murk_scene *s = mt_load_media(file, common, "type: delta, ", es, n);
     for (int i = 0; i < n; i++)
         assert_non_null(s->media[i].m.tr_vt); /* the estimator, not the tracker's own transmittance() */
     return s;
 }
 
-static const char *save_grid(const char *name, const int res[3], murk_vec3 lo, murk_vec3 hi,
-                             float (*f)(int, int, int, float, float, float))
-{
-    size_t n = (size_t)res[0] * res[1] * res[2];
-    float *v = malloc(n * sizeof *v);
-    assert_non_null(v);
-    for (int z = 0; z < res[2]; z++)
-        for (int y = 0; y < res[1]; y++)
-            for (int x = 0; x < res[0]; x++) {
-                float cx = lo.x + (hi.x - lo.x) * ((float)x + 0.5f) / (float)res[0];
-                float cy = lo.y + (hi.y - lo.y) * ((float)y + 0.5f) / (float)res[1];
-                float cz = lo.z + (hi.z - lo.z) * ((float)z + 0.5f) / (float)res[2];
-                v[((size_t)z * res[1] + y) * res[0] + x] = f(x, y, z, cx, cy, cz);
-            }
-    murk_field *fld = murk_field_from_voxels(res, lo, hi, v);
-    assert_non_null(fld);
-    free(v);
-    static char path[4][512];
-    static int next;
-    char *p = path[next++ & 3];
-    snprintf(p, sizeof path[0], "%s/%s", tmp_dir(), name);
-    char err[512];
-    if (murk_field_vol_save(p, fld, err, sizeof err) != 0)
-        fail_msg("%s", err);
-    murk_field_free(fld);
-    return p;
-}
-
-static float checker_f(int x, int y, int z, float cx, float cy, float cz)
-{
-    (void)cx, (void)cy, (void)cz;
-    return ((x + y + z) & 1) ? 1.4f : 0.2f;
-}
-/* int_0^1 (0.2 + 1.1 z) dz = 0.75 exactly on the interpolated grid (see test_media.c) */
-static float ramp_f(int x, int y, int z, float cx, float cy, float cz)
-{
-    (void)x, (void)y, (void)z, (void)cx, (void)cy;
-    return 0.2f + 1.1f * cz;
-}
-static float sinus_f(int x, int y, int z, float cx, float cy, float cz)
-{
-    (void)x, (void)y, (void)z;
-    return 0.18f + 0.13f * sinf(3.0f * cx + 1.0f) * sinf(2.5f * cy + 0.3f) * cosf(2.0f * cz);
-}
-
-/* optical depth (of the density) by the midpoint rule on the field as the core interpolates it */
-static double quadrature(const murk_medium *m, const murk_ray *ray)
-{
-    const int steps = 200000;
-    double h = ((double)ray->tmax - ray->tmin) / steps, acc = 0.0;
-    for (int i = 0; i < steps; i++)
-        acc += h * murk_media_density(m->data->density, murk_madd(ray->o, ray->d, (float)(ray->tmin + h * (i + 0.5))));
-    return acc;
-}
-
 typedef struct est {
-    long n;
-    double k[3], s[3], s2[3]; /* sums of x - k, k the first estimate (no cancellation when all are equal) */
+    mt_acc a;
     double secs;
 } est;
-
-static double mean_of(const est *e, int c) { return e->k[c] + e->s[c] / (double)e->n; }
-static double var_of(const est *e, int c)
-{
-    double m = e->s[c] / (double)e->n;
-    return fmax(0.0, (e->s2[c] - (double)e->n * m * m) / (double)(e->n - 1));
-}
-static double se_of(const est *e, int c) { return sqrt(var_of(e, c) / (double)e->n); }
 
 static void run(const murk_medium *m, const murk_ray *ray, long n, uint64_t seed, est *e)
 {
     memset(e, 0, sizeof *e);
-    e->n = n;
     murk_rng rng;
     murk_rng_seed(&rng, seed, 0x7472, 0);
     murk_path_ctx ctx;
     ctx.beta = murk_rgb1(1.0f);
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
+    double t0 = mt_seconds();
     long bad = 0;
     for (long i = 0; i < n; i++) {
-        ctx.hero = (int)(murk_rng_float(&rng) * 3.0f);
+        ctx.hero = mt_hero(&rng);
         murk_rgb T = murk_medium_transmittance(m, ray, &ctx, &rng);
         if (!murk_rgb_finite(T))
             bad++;
-        for (int c = 0; c < 3; c++) {
-            if (i == 0)
-                e->k[c] = T.c[c];
-            double x = (double)T.c[c] - e->k[c];
-            e->s[c] += x;
-            e->s2[c] += x * x;
-        }
+        mt_acc_add(&e->a, (double[3]){T.c[0], T.c[1], T.c[2]});
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    e->secs = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    e->secs = mt_seconds() - t0;
     if (bad) {
         printf("  %-22s %ld non-finite estimates  <-- FAIL\n", m->name, bad);
         nfail++;
     }
 }
 
-/* |mean - T| <= 4 se (+ float rounding) per channel; with power, a 3% error must be >= 5 se in the
- * best-measured channel. */
+/* mt_check: |mean - T| <= 4 se (+ float rounding) per channel; with power, a 3% error must be >= 5 se
+ * in the best-measured channel. */
 static void check(const char *label, const est *e, const double T[3], int power)
 {
-    char line[512];
-    size_t k = (size_t)snprintf(line, sizeof line, "  %-22s", label);
-    int bad = 0;
-    double res = 0.0;
-    for (int c = 0; c < 3; c++) {
-        double m = mean_of(e, c), se = se_of(e, c);
-        if (!(fabs(m - T[c]) <= 4.0 * se + 2e-6 * T[c] + 1e-7))
-            bad = 1;
-        res = fmax(res, se > 0.0 ? 0.03 * T[c] / se : INFINITY);
-        k += (size_t)snprintf(line + k, sizeof line - k, "  %.5f+-%.5f (%.5f, z %+.1f)", m, se, T[c],
-                              se > 0 ? (m - T[c]) / se : 0.0);
-    }
-    int weak = power && res < 5.0;
-    printf("%s  3%%=%.1f se  %.2f us%s%s\n", line, res, 1e6 * e->secs / (double)e->n, bad ? "  <-- FAIL" : "",
-           weak ? "  <-- too noisy to see a 3% error" : "");
-    nfail += bad + weak;
+    char head[64], tail[64];
+    snprintf(head, sizeof head, "  %-22s", label);
+    snprintf(tail, sizeof tail, "  %.2f us", 1e6 * e->secs / (double)e->a.n);
+    nfail += mt_check(head, &e->a, T, 2e-6, power, tail);
 }
 
-static const double GREY_ST[3] = {1.2, 1.2, 1.2}, CHROMA_ST[3] = {1.2, 1.5, 3.1};
-#define GREY_KEYS "sigma_a: 0.3, sigma_s: 0.9"
-#define CHROMA_KEYS "sigma_a: [0.2, 1, 3], sigma_s: [1, 0.5, 0.1]"
 #define N_MAIN 100000L
 
 typedef struct config {
@@ -214,19 +105,19 @@ typedef struct config {
 /* Every estimator of es on cfg, grey and chromatic, against exp(-sigma_t scale D) (extra: more medium
  * keys, `scale` among them). Returns the estimates in
  * out[chroma][i] if out is non-NULL. */
-static void check_config(const config *cfg, const char *extra, double scale, const espec *es, int n, est (*out)[16])
+static void check_config(const config *cfg, const char *extra, double scale, const mt_spec *es, int n, est (*out)[16])
 {
     for (int chroma = 0; chroma < 2; chroma++) {
         char common[1024];
-        snprintf(common, sizeof common, "density: %s, %s%s", cfg->density, chroma ? CHROMA_KEYS : GREY_KEYS, extra);
+        snprintf(common, sizeof common, "density: %s, %s%s", cfg->density, mt_sigma_keys(chroma), extra);
         murk_scene *s = load_media("tr.yaml", common, es, n);
-        double D = cfg->D >= 0 ? cfg->D : quadrature(&s->media[0].m, &cfg->ray), T[3];
+        double D = cfg->D >= 0 ? cfg->D : mt_quadrature(&s->media[0].m, &cfg->ray), T[3];
         if (cfg->D >= 0) { /* the closed form against the field the core built */
-            double q = quadrature(&s->media[0].m, &cfg->ray);
+            double q = mt_quadrature(&s->media[0].m, &cfg->ray);
             if (!(fabs(q - cfg->D) < 1e-4 * cfg->D))
                 fail_msg("%s: quadrature %.6f != closed form %.6f", cfg->name, q, cfg->D);
         }
-        const double *st = chroma ? CHROMA_ST : GREY_ST;
+        const double *st = mt_sigma_t[chroma];
         for (int c = 0; c < 3; c++)
             T[c] = exp(-st[c] * scale * D);
         printf("%s, %s (optical depth of the density %.5f)\n", cfg->name, chroma ? "chromatic" : "grey", D);
@@ -241,38 +132,23 @@ static void check_config(const config *cfg, const char *extra, double scale, con
     }
 }
 
+/* A grid case as a config: the density key names its .vol file. */
+static config grid_cfg(const char *name, mt_case g)
+{
+    static char dens[4][600];
+    static int next;
+    char *d = dens[next++ & 3];
+    snprintf(d, sizeof dens[0], "{ grid: %s }", g.grid);
+    return (config){name, d, g.ray, g.D};
+}
 static config slab_cfg(void)
 {
     return (config){"slab (constant 0.5)", "{ constant: 0.5 }",
                     {murk_v3(0.1f, -0.2f, 0.3f), murk_normalize(murk_v3(0.3f, 0.4f, 1.0f)), 0.0f, 1.5f}, 0.75};
 }
-static config checker_cfg(void)
-{
-    const char *grid = save_grid("checker.vol", (int[]){8, 8, 8}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), checker_f);
-    static char dens[600];
-    snprintf(dens, sizeof dens, "{ grid: %s }", grid);
-    double D = 0.0;
-    for (int x = 0; x < 8; x++)
-        D += checker_f(x, 3, 3, 0, 0, 0) / 8.0;
-    float yc = 3.5f / 8.0f;
-    return (config){"checker grid", dens, {murk_v3(-0.25f, yc, yc), murk_v3(1, 0, 0), 0.0f, 1.5f}, D};
-}
-static config ramp_cfg(void)
-{
-    const char *grid = save_grid("ramp.vol", (int[]){4, 4, 16}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), ramp_f);
-    static char dens[600];
-    snprintf(dens, sizeof dens, "{ grid: %s }", grid);
-    murk_vec3 d = murk_normalize(murk_v3(0.2f, 0.1f, 1.0f));
-    return (config){"linear ramp", dens, {murk_v3(0.3f, 0.4f, -0.5f), d, 0.0f, 2.5f}, 0.75 / d.z};
-}
-static config sinus_cfg(void)
-{
-    const char *grid = save_grid("sinus.vol", (int[]){16, 16, 16}, murk_v3(-1, -1, -1), murk_v3(1, 1, 1), sinus_f);
-    static char dens[600];
-    snprintf(dens, sizeof dens, "{ grid: %s }", grid);
-    return (config){"sinusoid", dens,
-                    {murk_v3(-1.5f, -1.2f, -1.4f), murk_normalize(murk_v3(1.0f, 0.8f, 0.9f)), 1.0f, 4.0f}, -1.0};
-}
+static config checker_cfg(void) { return grid_cfg("checker grid", mt_checker_case()); }
+static config ramp_cfg(void) { return grid_cfg("linear ramp", mt_ramp_case()); }
+static config sinus_cfg(void) { return grid_cfg("sinusoid", mt_sinus_case()); }
 
 /* ---- closed forms ------------------------------------------------------------------------------ */
 
@@ -310,7 +186,7 @@ static void test_bounds_fail(void **state)
 {
     (void)state;
     nfail = 0;
-    static const espec es[] = {
+    static const mt_spec es[] = {
         {"ratio", "transmittance: ratio", 1},
         {"residual_ratio", "transmittance: residual_ratio", 1},
         {"residual_ratio_c2", "transmittance: { type: residual_ratio, control: 2 }", 1},
@@ -323,7 +199,7 @@ static void test_bounds_fail(void **state)
     c.name = "sinusoid, majorant_factor 0.6, scale 0.5";
     check_config(&c, ", majorant_factor: 0.6, scale: 0.5", 0.5, es, (int)(sizeof es / sizeof es[0]), NULL);
     /* the control alone above the density, with a bounding majorant */
-    static const espec es2[] = {
+    static const mt_spec es2[] = {
         {"residual_ratio_c2", "transmittance: { type: residual_ratio, control: 2 }", 1},
         {"residual_ratio_c4", "transmittance: { type: residual_ratio, control: 4 }", 1},
     };
@@ -338,7 +214,7 @@ static void test_variance(void **state)
 {
     (void)state;
     nfail = 0;
-    static const espec es[] = {
+    static const mt_spec es[] = {
         {"ratio", "transmittance: ratio", 0},
         {"residual_ratio", "transmittance: residual_ratio", 0},
         {"track_length", "transmittance: track_length", 0},
@@ -355,10 +231,10 @@ static void test_variance(void **state)
         for (int chroma = 0; chroma < 2; chroma++) {
             printf("  variance per channel (%s):\n", chroma ? "chromatic" : "grey");
             for (int i = 0; i < NE; i++)
-                printf("    %-20s %.3e %.3e %.3e\n", es[i].label, var_of(&out[chroma][i], 0), var_of(&out[chroma][i], 1),
-                       var_of(&out[chroma][i], 2));
+                printf("    %-20s %.3e %.3e %.3e\n", es[i].label, mt_var(&out[chroma][i].a, 0), mt_var(&out[chroma][i].a, 1),
+                       mt_var(&out[chroma][i].a, 2));
             for (int c = 0; c < 3; c++) {
-                double vtl = var_of(&out[chroma][TL], c);
+                double vtl = mt_var(&out[chroma][TL].a, c);
                 /* ratio tracking is track length's expectation given the tentative collisions (Rao-
                  * Blackwell), so it can only be less variable, and equally so where every weight is 0 or
                  * 1 (an exact majorant: the slab, nearly on the ramp). Where the majorant is loose
@@ -366,22 +242,22 @@ static void test_variance(void **state)
                  * beyond noise (a sample variance of n = 1e5 has relative se < 0.5% here: 2% margin). */
                 double margin = (k == 1 || k == 3) ? 0.95 : 1.02;
                 for (int i = 0; i < NE; i++) {
-                    if (i != TL && !(var_of(&out[chroma][i], c) < margin * vtl)) {
+                    if (i != TL && !(mt_var(&out[chroma][i].a, c) < margin * vtl)) {
                         printf("    %s variance %.3e not below track_length's %.3e (channel %d)  <-- FAIL\n",
-                               es[i].label, var_of(&out[chroma][i], c), vtl, c);
+                               es[i].label, mt_var(&out[chroma][i].a, c), vtl, c);
                         nfail++;
                     }
                 }
                 if (k < 2) { /* constant density: the ray-marched control is exact */
-                    double T = exp(-(chroma ? CHROMA_ST : GREY_ST)[c] * 0.75);
-                    if (!(var_of(&out[chroma][URM], c) <= 1e-12 * T * T)) {
+                    double T = exp(-mt_sigma_t[chroma][c] * 0.75);
+                    if (!(mt_var(&out[chroma][URM].a, c) <= 1e-12 * T * T)) {
                         printf("    unbiased_raymarch variance %.3e on constant density (channel %d)  <-- FAIL\n",
-                               var_of(&out[chroma][URM], c), c);
+                               mt_var(&out[chroma][URM].a, c), c);
                         nfail++;
                     }
-                    if (!(var_of(&out[chroma][RESIDUAL], c) <= 1e-10 * T * T)) {
+                    if (!(mt_var(&out[chroma][RESIDUAL].a, c) <= 1e-10 * T * T)) {
                         printf("    residual_ratio variance %.3e on constant density (channel %d)  <-- FAIL\n",
-                               var_of(&out[chroma][RESIDUAL], c), c);
+                               mt_var(&out[chroma][RESIDUAL].a, c), c);
                         nfail++;
                     }
                 }
@@ -400,13 +276,13 @@ static void test_raymarch_bias(void **state)
     static const double steps[] = {0.4, 0.2, 0.1, 0.05, 0.025};
     enum { NS = 5, NRAYS = 64 };
     for (int jitter = 1; jitter >= 0; jitter--) {
-        espec es[NS];
+        mt_spec es[NS];
         static char keys[NS][128], labels[NS][32];
         for (int i = 0; i < NS; i++) {
             snprintf(keys[i], sizeof keys[i], "transmittance: { type: raymarch, step: %g, jitter: %s }", steps[i],
                      jitter ? "true" : "false");
             snprintf(labels[i], sizeof labels[i], "raymarch_%g", steps[i]);
-            es[i] = (espec){labels[i], keys[i], 1};
+            es[i] = (mt_spec){labels[i], keys[i], 1};
         }
         config c = sinus_cfg();
         char common[1024]; /* denser than the closed-form tests (sigma_t 4), so that the bias is large */
@@ -414,15 +290,15 @@ static void test_raymarch_bias(void **state)
         murk_scene *s = load_media("rm.yaml", common, es, NS);
         double bias[NS], se[NS];
         if (jitter) { /* one ray, many jittered marches: the mean's bias (Jensen) against its se */
-            double D = quadrature(&s->media[0].m, &c.ray), T = exp(-4.0 * D);
+            double D = mt_quadrature(&s->media[0].m, &c.ray), T = exp(-4.0 * D);
             printf("raymarch bias, sinusoid, sigma_t 4, jittered, one ray (optical depth %.4f, T %.5f):\n", 4.0 * D, T);
             for (int i = 0; i < NS; i++) {
                 est e;
                 run(&s->media[i].m, &c.ray, 200000L, 900 + (uint64_t)i, &e);
-                bias[i] = mean_of(&e, 0) - T;
-                se[i] = se_of(&e, 0);
+                bias[i] = mt_mean(&e.a, 0) - T;
+                se[i] = mt_se(&e.a, 0);
                 printf("  step %-6g mean %.6f +- %.6f  bias %+.3e (%+.1f se, relative %+.2e)\n", steps[i],
-                       mean_of(&e, 0), se[i], bias[i], bias[i] / se[i], bias[i] / T);
+                       mt_mean(&e.a, 0), se[i], bias[i], bias[i] / se[i], bias[i] / T);
             }
         } else { /* deterministic: its error on one ray oscillates with the step (the field's edges meet
                   * the lattice at other phases), so the bias is the RMS relative error over 64 rays */
@@ -435,7 +311,7 @@ static void test_raymarch_bias(void **state)
                 murk_vec3 d = murk_normalize(murk_v3(0.6f * (murk_rng_float(&rng) - 0.5f),
                                                      0.6f * (murk_rng_float(&rng) - 0.5f), 1.0f));
                 murk_ray ray = {o, d, 0.0f, 3.5f};
-                double T = exp(-4.0 * quadrature(&s->media[0].m, &ray));
+                double T = exp(-4.0 * mt_quadrature(&s->media[0].m, &ray));
                 for (int i = 0; i < NS; i++) {
                     murk_path_ctx ctx = {0, murk_rgb1(1.0f)};
                     murk_rgb e = murk_medium_transmittance(&s->media[i].m, &ray, &ctx, &rng);

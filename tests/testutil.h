@@ -6,7 +6,23 @@
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
+#include <string.h>
 #include <cmocka.h>
+
+/* Fails the test, printing the haystack, unless hay (may be NULL) contains needle / does not. */
+#define assert_contains(hay, needle)                                                                   \
+    do {                                                                                               \
+        const char *h_ = (hay), *n_ = (needle);                                                        \
+        if (!h_ || !strstr(h_, n_))                                                                    \
+            fail_msg("expected \"%s\" in:\n%s", n_, h_ ? h_ : "(null)");                               \
+    } while (0)
+
+#define assert_not_contains(hay, needle)                                                               \
+    do {                                                                                               \
+        const char *h_ = (hay), *n_ = (needle);                                                        \
+        if (h_ && strstr(h_, n_))                                                                      \
+            fail_msg("did not expect \"%s\" in:\n%s", n_, h_);                                         \
+    } while (0)
 
 /* Absolute path of a file in the source tree / build tree (static buffer rotated 8 ways). */
 const char *src_path(const char *rel);
