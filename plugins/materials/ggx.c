@@ -162,42 +162,33 @@ static void ggx_shade_at(const ggx *g, const murk_hit *hit, ggx_shade *sh)
     }
 }
 
-/* Bilinear lookup of M(mu, alpha), mu in [0, 1]. */
-static float ggx_m_lookup(const ggx_shade *sh, float mu)
+/* Bilinear lookup in a GGX_TAB_N x GGX_TAB_N table at column coordinate t in [0, 1] and row r (the
+ * shading's sqrt(alpha)). */
+static float tab_lookup(const float tab[GGX_TAB_N][GGX_TAB_N], float t01, float r)
 {
-    float t = sqrtf(clamp01(mu)) * (float)(GGX_TAB_N - 1);
+    float t = t01 * (float)(GGX_TAB_N - 1);
     int i = (int)t;
     if (i > GGX_TAB_N - 2)
         i = GGX_TAB_N - 2;
     float ft = t - (float)i;
-    float x = sh->r * (float)(GGX_TAB_N - 1);
+    float x = r * (float)(GGX_TAB_N - 1);
     int j = (int)x;
     if (j > GGX_TAB_N - 2)
         j = GGX_TAB_N - 2;
     float fr = x - (float)j;
-    float m0 = ggx_m[j][i] + (ggx_m[j][i + 1] - ggx_m[j][i]) * ft;
-    float m1 = ggx_m[j + 1][i] + (ggx_m[j + 1][i + 1] - ggx_m[j + 1][i]) * ft;
-    return m0 + (m1 - m0) * fr;
+    float v0 = tab[j][i] + (tab[j][i + 1] - tab[j][i]) * ft;
+    float v1 = tab[j + 1][i] + (tab[j + 1][i + 1] - tab[j + 1][i]) * ft;
+    return v0 + (v1 - v0) * fr;
 }
 
-/* Bilinear lookup of E(mu, alpha), mu in [0, 1], on the table's axis w = mu (1 + alpha) / (mu + alpha). */
+/* M(mu, alpha), mu in [0, 1], on the table's axis t = sqrt(mu). */
+static float ggx_m_lookup(const ggx_shade *sh, float mu) { return tab_lookup(ggx_m, sqrtf(clamp01(mu)), sh->r); }
+
+/* E(mu, alpha), mu in [0, 1], on the table's axis w = mu (1 + alpha) / (mu + alpha). */
 static float ggx_e_lookup(const ggx_shade *sh, float mu)
 {
     mu = clamp01(mu);
-    float w = mu * (1.0f + sh->alpha) / (mu + sh->alpha);
-    float t = clamp01(w) * (float)(GGX_TAB_N - 1);
-    int i = (int)t;
-    if (i > GGX_TAB_N - 2)
-        i = GGX_TAB_N - 2;
-    float ft = t - (float)i;
-    float x = sh->r * (float)(GGX_TAB_N - 1);
-    int j = (int)x;
-    if (j > GGX_TAB_N - 2)
-        j = GGX_TAB_N - 2;
-    float fr = x - (float)j;
-    float e0 = ggx_e[j][i] + (ggx_e[j][i + 1] - ggx_e[j][i]) * ft;
-    float e1 = ggx_e[j + 1][i] + (ggx_e[j + 1][i + 1] - ggx_e[j + 1][i]) * ft;
-    return e0 + (e1 - e0) * fr;
+    return tab_lookup(ggx_e, clamp01(mu * (1.0f + sh->alpha) / (mu + sh->alpha)), sh->r);
 }
 
 /* Compensated model at one cosine: e = E(mu), and per channel the coat's energy bound
