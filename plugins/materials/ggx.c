@@ -206,6 +206,20 @@ static void ggx_ms_at(const ggx_shade *sh, float mu, ggx_msat *a)
     }
 }
 
+/* Probability of sampling the coat from the expected contributions of what it samples (es) and of what
+ * the cosine lobe samples (ed): their luminance ratio, clamped to [GGX_PSPEC_MIN, GGX_PSPEC_MAX] when
+ * both are non-zero, exactly 1 or 0 when one is. */
+static float pspec_from(murk_rgb es, murk_rgb ed)
+{
+    float ws = murk_luminance(es), wd = murk_luminance(ed);
+    if (!(wd > 0.0f))
+        return 1.0f;
+    if (!(ws > 0.0f))
+        return 0.0f;
+    float p = ws / (ws + wd);
+    return p < GGX_PSPEC_MIN ? GGX_PSPEC_MIN : (p > GGX_PSPEC_MAX ? GGX_PSPEC_MAX : p);
+}
+
 /* Probability of sampling the coat, from the lobes' expected contributions at wo. mo = M(mu_o). */
 static float ggx_pspec(const ggx_shade *sh, float mo)
 {
@@ -215,13 +229,7 @@ static float ggx_pspec(const ggx_shade *sh, float mo)
         ef.c[c] = f0 + (1.0f - f0) * mo;
         ed.c[c] = sh->albedo.c[c] * (1.0f - f0) * (1.0f - mo);
     }
-    float ws = murk_luminance(ef), wd = murk_luminance(ed);
-    if (!(wd > 0.0f))
-        return 1.0f;
-    if (!(ws > 0.0f))
-        return 0.0f;
-    float p = ws / (ws + wd);
-    return p < GGX_PSPEC_MIN ? GGX_PSPEC_MIN : (p > GGX_PSPEC_MAX ? GGX_PSPEC_MAX : p);
+    return pspec_from(ef, ed);
 }
 
 /* The same for the compensated model: the coat's single scattering against everything sampled from the
@@ -235,13 +243,7 @@ static float ggx_pspec_ms(const ggx_shade *sh, float mu_o)
         es.c[c] = a.ss[c];
         ed.c[c] = sh->fms[c] * (1.0f - a.e) + sh->albedo.c[c] * a.one_x[c];
     }
-    float ws = murk_luminance(es), wd = murk_luminance(ed);
-    if (!(wd > 0.0f))
-        return 1.0f;
-    if (!(ws > 0.0f))
-        return 0.0f;
-    float p = ws / (ws + wd);
-    return p < GGX_PSPEC_MIN ? GGX_PSPEC_MIN : (p > GGX_PSPEC_MAX ? GGX_PSPEC_MAX : p);
+    return pspec_from(es, ed);
 }
 
 static float ggx_pspec_at(const ggx_shade *sh, float mu_o)
