@@ -265,17 +265,17 @@ static void test_resume_refuses(void **state)
     int rc = run_murk(&out, "render", src_path("scenes/cornell_smoke.yaml"), "-o", build_path("x_resume.exr"),
                       "--resume", ck, "--quiet", NULL);
     assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "checkpoint of another scene"));
+    assert_contains(out, "checkpoint of another scene");
     free(out);
     rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
                   "render.resolution=[48,41]", NULL);
     assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "other --set overrides"));
+    assert_contains(out, "other --set overrides");
     free(out);
     rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
                   "render.resolution=[48,40]", "--spp", "8", NULL);
     assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "more than the 8 asked for"));
+    assert_contains(out, "more than the 8 asked for");
     free(out);
     /* a damaged checkpoint */
     FILE *f = fopen(ck, "r+b");
@@ -286,7 +286,7 @@ static void test_resume_refuses(void **state)
     rc = run_murk(&out, "render", scene_path(), "-o", build_path("x_resume.exr"), "--resume", ck, "--quiet", "--set",
                   "render.resolution=[48,40]", NULL);
     assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "damaged checkpoint"));
+    assert_contains(out, "damaged checkpoint");
     free(out);
 }
 
