@@ -209,8 +209,11 @@ static int cmd_render(int argc, char **argv)
     mpi_run.size = murk_mpi_init(err, sizeof err);
     if (err[0])
         fprintf(stderr, "murk: warning: %s\n", err);
-    if (mpi_run.size < 2)
-        return render_main(argc, argv);
+    if (mpi_run.size < 2) { /* alone (mpirun -n 1 too) */
+        int rc = render_main(argc, argv);
+        murk_mpi_finalize();
+        return rc;
+    }
     mpi_run.rank = murk_mpi_rank();
     if (mpi_run.rank > 0) {
         mpi_run.capture = tmpfile();
