@@ -2,7 +2,14 @@
 #ifndef MURK_CLI_H
 #define MURK_CLI_H
 
-/* Runs `murk render | plugins | compare | grid | --version | --help`; returns the exit status. */
+/* Runs `murk render | plugins | compare | bench | grid | --version | --help`; returns the exit status. */
 int murk_cli_main(int argc, char **argv);
+
+/* Shared by the subcommands' files. */
+const char *murk_cli_q(const char *s); /* untrusted text made printable (eight rotating buffers) */
+void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
+int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
+
+int murk_cli_compare(int argc, char **argv); /* compare.c */
 
 #endif
