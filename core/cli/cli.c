@@ -271,12 +271,14 @@ static int cmd_render(int argc, char **argv)
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
+    static char counters[16384];
+    murk_cli_counters_json(s, &res, counters, sizeof counters);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
-        {"murk:resumed_from", opts.resume ? opts.resume : ""},
+        {"murk:resumed_from", opts.resume ? opts.resume : ""}, {"murk:counters", counters},
     };
     char *png = png_path_for(outbuf);
     int rc = ck_failed ? 1 : 0;
@@ -301,6 +303,7 @@ static int cmd_render(int argc, char **argv)
         human((double)res.rays / res.seconds, rps, sizeof rps);
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
+        murk_cli_counters_print(stdout, s, &res);
     }
     murk_warn_summary();
     if (res.nonfinite)

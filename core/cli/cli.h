@@ -12,4 +12,11 @@ int murk_cli_usage(const char *msg);   /* the message and the usage text on stde
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
 
+/* The cost counters (murk/counters.h) of a render as JSON for the EXR's murk:counters, and as the
+ * end-of-render summary's lines (bench.c). */
+#include <stdio.h>
+#include "murk/murk.h"
+void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n);
+void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r);
+
 #endif

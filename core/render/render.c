@@ -33,6 +33,9 @@ typedef struct job {
     atomic_uint_fast64_t rays, nonfinite;
     volatile sig_atomic_t *stop; /* set: take no more tiles; the pass is abandoned */
     atomic_int abandoned;
+    pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
+    size_t nslots;
+    murk_counters media[MURK_COUNTER_SLOTS];
 } job;
 
 static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
@@ -93,6 +96,9 @@ static void *worker(void *arg)
     }
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
+    pthread_mutex_lock(&j->lock);
+    murk_host_thread_counters_add(j->media, j->nslots);
+    pthread_mutex_unlock(&j->lock);
     return NULL;
 }
 
@@ -182,6 +188,8 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     atomic_init(&j.rays, 0);
     atomic_init(&j.nonfinite, 0);
     atomic_init(&j.abandoned, 0);
+    pthread_mutex_init(&j.lock, NULL);
+    j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
 
     int done = 0, rc = 0;
     uint64_t rays_before = 0;
@@ -281,6 +289,9 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     out->samples = (uint64_t)(done - start) * npix;
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
+    out->nmedia = (int)j.nslots;
+    memcpy(out->media, j.media, sizeof j.media);
+    pthread_mutex_destroy(&j.lock);
     free(j.sum);
     free(j.count);
     return rc;
