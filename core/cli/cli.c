@@ -41,7 +41,7 @@ static const char usage_text[] =
 
 /* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
  * eight rotating buffers, so one message may quote several. */
-static const char *q(const char *s)
+const char *murk_cli_q(const char *s)
 {
     static char buf[8][1024];
     static int k;
@@ -49,11 +49,15 @@ static const char *q(const char *s)
     return murk_printable(buf[k], sizeof buf[k], s);
 }
 
+#define q(s) murk_cli_q(s)
+#define cli_error(m) murk_cli_error(m)
+#define usage(m) murk_cli_usage(m)
+
 /* "murk: MESSAGE" for a message built from input (the scene's and loaders' errors are printable
  * already; plugin and image errors may quote a raw argument). */
-static void cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", q(msg)); }
+void murk_cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", murk_cli_q(msg)); }
 
-static int usage(const char *msg)
+int murk_cli_usage(const char *msg)
 {
     if (msg)
         fprintf(stderr, "murk: %s\n", msg);
@@ -421,12 +425,14 @@ static int render_main(int argc, char **argv)
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
+    static char counters[16384];
+    murk_cli_counters_json(s, &res, counters, sizeof counters);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
-        {"murk:resumed_from", opts.resume ? opts.resume : ""},
+        {"murk:resumed_from", opts.resume ? opts.resume : ""}, {"murk:counters", counters},
         /* the job: processes, render threads, seconds those threads spent in tiles (summed over ranks) */
         {"murk:ranks", ranks}, {"murk:threads", threads}, {"murk:thread_time", tsecs},
         /* a --part render: what murk merge checks and needs */
@@ -462,6 +468,7 @@ static int render_main(int argc, char **argv)
         human((double)res.rays / res.seconds, rps, sizeof rps);
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
+        murk_cli_counters_print(stdout, s, &res);
     }
     murk_warn_summary();
     if (res.nonfinite)
@@ -597,100 +604,6 @@ static int cmd_plugins(int argc, char **argv)
     return rc;
 }
 
-/* ---- compare ------------------------------------------------------------------------------- */
-
-static int cmp_float(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
-
-static int cmd_compare(int argc, char **argv)
-{
-    const char *a = NULL, *b = NULL, *diff = NULL;
-    for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--diff")) {
-            if (i + 1 >= argc)
-                return usage("--diff needs a .png file name");
-            diff = argv[++i];
-        } else if (!a) {
-            a = argv[i];
-        } else if (!b) {
-            b = argv[i];
-        } else {
-            return usage("compare takes two images");
-        }
-    }
-    if (!a || !b)
-        return usage("compare needs two EXR files: TEST REFERENCE");
-    murk_image A = {0}, B = {0};
-    char err[1024];
-    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
-        cli_error(err);
-        murk_image_free(&A);
-        return 1;
-    }
-    int rc = 0;
-    if (A.w != B.w || A.h != B.h) {
-        fprintf(stderr, "murk: %s is %dx%d but %s is %dx%d\n", a, A.w, A.h, b, B.w, B.h);
-        rc = 1;
-    } else {
-        size_t n = (size_t)A.w * (size_t)A.h;
-        double mse = 0, rel = 0, mar = 0;
-        size_t bad = 0;
-        float *d = murk_xmalloc(n * sizeof(float));
-        for (size_t i = 0; i < n; i++) {
-            double dp = 0;
-            for (int c = 0; c < 3; c++) {
-                double x = A.rgb[3 * i + (size_t)c], r = B.rgb[3 * i + (size_t)c];
-                if (!isfinite(x) || !isfinite(r)) {
-                    bad++;
-                    continue;
-                }
-                double e = x - r;
-                mse += e * e;
-                rel += e * e / (r * r + 1e-2);
-                mar += fabs(e) / (fabs(r) + 1e-2);
-                dp += fabs(e);
-            }
-            d[i] = (float)(dp / 3);
-        }
-        double m = 3.0 * (double)n;
-        printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
-               mse / m, rel / m, mar / m, a, b);
-        if (bad)
-            printf("warning: %zu non-finite values skipped\n", bad);
-        if (diff) {
-            float *sorted = murk_xmalloc(n * sizeof(float));
-            memcpy(sorted, d, n * sizeof(float));
-            qsort(sorted, n, sizeof(float), cmp_float);
-            float p99 = sorted[(size_t)(0.99 * (double)(n - 1))];
-            float scale = p99 > 0 ? 1.0f / p99 : 1.0f;
-            free(sorted);
-            float *rgb = murk_xmalloc(3 * n * sizeof(float));
-            for (size_t i = 0; i < n; i++) { /* black -> red -> yellow -> white heat map */
-                float t = fminf(1.0f, d[i] * scale);
-                rgb[3 * i] = fminf(1.0f, 3 * t);
-                rgb[3 * i + 1] = fminf(1.0f, fmaxf(0.0f, 3 * t - 1));
-                rgb[3 * i + 2] = fmaxf(0.0f, 3 * t - 2);
-                for (int c = 0; c < 3; c++) /* the PNG writer applies the sRGB curve: undo it */
-                    rgb[3 * i + (size_t)c] = powf(rgb[3 * i + (size_t)c], 2.2f);
-            }
-            if (murk_png_write(diff, rgb, A.w, A.h, 0.0f, err, sizeof err)) {
-                cli_error(err);
-                rc = 1;
-            } else {
-                printf("diff image %s: |a-b| averaged over channels, white = 99th percentile (%.3e)\n", diff, p99);
-            }
-            free(rgb);
-        }
-        free(d);
-    }
-    murk_image_free(&A);
-    murk_image_free(&B);
-    return rc;
-}
-
 /* ---- grid ---------------------------------------------------------------------------------- */
 
 /* A number read as strictly as the scene's (yread.c): a whole decimal token, no leading space, no hex,
@@ -820,7 +733,7 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "plugins"))
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
-        return cmd_compare(argc - 2, argv + 2);
+        return murk_cli_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "check"))
         return murk_check_main(argc - 1, argv + 1);
     if (!strcmp(cmd, "grid"))

@@ -55,6 +55,9 @@ typedef struct job {
     atomic_uint_fast64_t rays, nonfinite, busy_ns;
     volatile sig_atomic_t *stop; /* set: take no more tiles; the pass is abandoned */
     atomic_int abandoned;
+    pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
+    size_t nslots;
+    murk_counters media[MURK_COUNTER_SLOTS];
     tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
 } job;
 
@@ -176,6 +179,9 @@ static void *worker(void *arg)
     }
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
+    pthread_mutex_lock(&j->lock);
+    murk_host_thread_counters_add(j->media, j->nslots);
+    pthread_mutex_unlock(&j->lock);
     return NULL;
 }
 
@@ -435,6 +441,19 @@ static void send_passes(int cmd, int spp0, int spp1)
         murk_mpi_bcast(&pm, sizeof pm);
 }
 
+/* Collective at the end: the render threads and cost counters of every rank into rank 0's out and j. */
+static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
+{
+    enum { N = 1 + MURK_COUNTER_SLOTS * MURK_NCOUNTERS };
+    uint64_t v[N];
+    _Static_assert(sizeof j->media == MURK_COUNTER_SLOTS * MURK_NCOUNTERS * sizeof(uint64_t), "counters are uint64s");
+    v[0] = (uint64_t)nthreads;
+    memcpy(v + 1, j->media, sizeof j->media);
+    murk_mpi_sum_u64(v, N);
+    out->threads = (int)v[0];
+    memcpy(j->media, v + 1, sizeof j->media);
+}
+
 /* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end. */
 static int follow_passes(job *j, int nthreads, murk_render_result *out)
 {
@@ -457,9 +476,8 @@ static int follow_passes(job *j, int nthreads, murk_render_result *out)
     }
     queue_free(&inq);
     queue_free(&outq);
-    uint64_t threads = (uint64_t)nthreads;
     if (pm.cmd == PASS_END)
-        murk_mpi_sum_u64(&threads, 1);
+        sum_over_ranks(j, nthreads, out);
     out->spp = pm.spp0;
     out->interrupted = pm.spp1;
     return pm.cmd == PASS_END ? 0 : -1;
@@ -500,11 +518,14 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     atomic_init(&j.nonfinite, 0);
     atomic_init(&j.busy_ns, 0);
     atomic_init(&j.abandoned, 0);
+    pthread_mutex_init(&j.lock, NULL);
+    j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
     out->width = s->width;
     out->height = s->height;
     out->ranks = murk_mpi_size();
     if (murk_mpi_rank() > 0) {
         int rc = follow_passes(&j, nthreads, out);
+        pthread_mutex_destroy(&j.lock);
         free(j.sum);
         free(j.count);
         free(tiles);
@@ -598,8 +619,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     }
     out->interrupted = done < spp && opts->stop && *opts->stop;
     send_passes(PASS_END, done, out->interrupted);
-    uint64_t threads = (uint64_t)nthreads;
-    murk_mpi_sum_u64(&threads, 1);
+    sum_over_ranks(&j, nthreads, out);
     if (rc == 0 && opts->checkpoint && save_checkpoint(s, opts, &j, done, err, errlen) != 0)
         rc = -1;
     free(keep_sum);
@@ -610,7 +630,6 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     }
     out->seconds = murk_now() - t0;
     out->spp = done;
-    out->threads = (int)threads;
     out->thread_seconds = (double)atomic_load(&j.busy_ns) * 1e-9;
     out->rgb = murk_xmalloc(3 * npix * sizeof(float));
     for (size_t i = 0; i < npix; i++)
@@ -619,6 +638,9 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     out->samples = (uint64_t)(done - start) * npix_rendered;
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
+    out->nmedia = (int)j.nslots;
+    memcpy(out->media, j.media, sizeof j.media);
+    pthread_mutex_destroy(&j.lock);
     free(j.sum);
     free(j.count);
     free(tiles);

@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "murk/counters.h"
+
 typedef struct murk_scene murk_scene;
 
 typedef struct murk_render_opts {
@@ -37,6 +39,10 @@ typedef struct murk_render_result {
     uint64_t samples, rays, nonfinite; /* samples and rays: this run's; nonfinite: the image's (resumed too) */
     int interrupted;        /* opts->stop was set before spp was reached */
     int resumed_spp;        /* spp taken from opts->resume */
+    /* This run's cost counters per medium, in the scene's order (murk/counters.h): nmedia blocks, the
+     * last one shared when the scene has more than MURK_COUNTER_SLOTS media. */
+    int nmedia;
+    murk_counters media[MURK_COUNTER_SLOTS];
     /* The job (summed over MPI ranks): processes, render threads, seconds those threads spent in tiles. */
     int ranks, threads;
     double thread_seconds;
