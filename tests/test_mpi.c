@@ -1,5 +1,6 @@
 /* test_mpi.c — `mpirun -n N murk render` (issue 13, items 1 and 5). A scene with a medium rendered by 1, 2
- * and 3 ranks is bitwise the single-process render; so are a render resumed by 3 ranks from the
+ * and 3 ranks is bitwise the single-process render, with the same rays and cost counters (summed over
+ * the ranks); so are a render resumed by 3 ranks from the
  * checkpoint 2 ranks wrote, and a --time render (rank 0 decides the passes) against a single-process
  * render of the spp it reached. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
  * job with the located message naming that rank, a non-zero status and no image. Skipped (exit 77)
@@ -71,6 +72,9 @@ static void ranks_give_the_single_process_image(void **state)
         snprintf(want, sizeof want, "%d", ranks);
         assert_string_equal(meta(tmp_path(out), "murk:ranks"), want);
         assert_string_equal(meta(tmp_path(out), "murk:threads"), want);
+        char counters[256]; /* rays and cost counters, summed over the ranks, are the single process's */
+        snprintf(counters, sizeof counters, "%s", meta(tmp_path("single.exr"), "murk:counters"));
+        assert_string_equal(meta(tmp_path(out), "murk:counters"), counters);
     }
 }
 

@@ -1,5 +1,6 @@
 /* test_parts.c — `murk render --part I/N` and `murk merge` (issue 13, item 2). The parts 0/3, 1/3, 2/3 of
- * a scene with a medium, merged, are bitwise the single-process render (EXR pixels and PNG bytes); a
+ * a scene with a medium, merged, are bitwise the single-process render (EXR pixels and PNG bytes) with
+ * its rays and cost counters; a
  * missing part, a part of another scene, a part given twice, an interrupted-looking or whole image each
  * fail with a message naming the culprit, and leave no output. */
 #include "image.h"
@@ -93,10 +94,16 @@ static void merged_parts_are_the_whole_image(void **state)
     assert_string_equal(murk_image_meta(&img, "murk:part_tiles"), "7");
     assert_non_null(murk_image_meta(&img, "murk:scene_hash"));
     murk_image_free(&img);
+    murk_image whole = {0};
     assert_int_equal(murk_exr_read(tmp_path("merged.exr"), &img, err, sizeof err), 0);
+    assert_int_equal(murk_exr_read(tmp_path("whole.exr"), &whole, err, sizeof err), 0);
     assert_null(murk_image_meta(&img, "murk:part"));
     assert_string_equal(murk_image_meta(&img, "murk:merged_from"), "3 parts");
+    /* rays and cost counters summed over the parts: the single process's */
+    assert_string_equal(murk_image_meta(&img, "murk:counters"), murk_image_meta(&whole, "murk:counters"));
+    assert_string_equal(murk_image_meta(&img, "murk:nonfinite_samples"), "0");
     murk_image_free(&img);
+    murk_image_free(&whole);
 }
 
 /* merge fails naming `needle`, and writes neither the EXR nor the PNG. */

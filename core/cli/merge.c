@@ -8,7 +8,8 @@
  * --set, seed, spp, resolution, split, murk version, integrator, plugins), be whole (not interrupted),
  * and every I of 0..N-1 must be given exactly once; otherwise the error names the file (or the missing
  * part). Parts are read one at a time, so memory holds two images whatever N. The merged EXR carries
- * the first part's attributes with the times, NaN counts, ranks and threads summed over the parts, and
+ * the first part's attributes with the times, NaN counts, ranks, threads and cost counters (the numbers
+ * of murk:counters) summed over the parts — so its counters are the single-process render's — and
  * its PNG preview is written beside it as `render` does: both files or neither. */
 #include "cli.h"
 #include "atomic.h"
@@ -30,6 +31,39 @@ static const char *const sum_keys[] = {"murk:render_time", "murk:nonfinite_sampl
                                        "murk:thread_time"};
 /* Attributes of a part that the merged image does not carry. */
 static const char *const part_keys[] = {"murk:part", "murk:part_tiles"};
+
+/* acc += add for two JSON texts of one shape (murk:counters of the parts of one render): every number
+ * outside a string is summed, everything else must be the same. 0, or -1 (acc unchanged) if not. */
+static int json_add(char *acc, size_t n, const char *add)
+{
+    char *out = murk_xmalloc(n);
+    const char *a = acc, *b = add;
+    size_t k = 0;
+    int in_str = 0;
+    while (*a && k + 1 < n) {
+        if (!in_str && *a >= '0' && *a <= '9' && *b >= '0' && *b <= '9') {
+            char *ea, *eb;
+            unsigned long long x = strtoull(a, &ea, 10), y = strtoull(b, &eb, 10);
+            k += (size_t)snprintf(out + k, n - k, "%llu", x + y);
+            a = ea, b = eb;
+            continue;
+        }
+        if (*a != *b)
+            break;
+        if (*a == '"')
+            in_str = !in_str;
+        else if (in_str && *a == '\\' && a[1] && a[1] == b[1])
+            out[k++] = *a++, b++;
+        out[k++] = *a++, b++;
+    }
+    int ok = !*a && !*b && k < n;
+    if (ok) {
+        out[k] = 0;
+        memcpy(acc, out, k + 1);
+    }
+    free(out);
+    return ok ? 0 : -1;
+}
 
 static const char *meta_or_empty(const murk_image *img, const char *key)
 {
@@ -91,6 +125,7 @@ int murk_cli_merge(int argc, char **argv)
     float *rgb = NULL;
     const char **owner = NULL; /* the file given for each part index */
     double sums[sizeof sum_keys / sizeof sum_keys[0]] = {0};
+    static char counters[16384]; /* murk:counters summed over the parts */
     int n = 0, rc = 0;
     for (int k = 0; k < nparts && rc == 0; k++) {
         murk_image *p = k ? &img : &first;
@@ -152,6 +187,10 @@ int murk_cli_merge(int argc, char **argv)
                            p->rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x), 3 * sizeof(float));
         for (size_t s = 0; s < sizeof sum_keys / sizeof sum_keys[0]; s++)
             sums[s] += strtod(meta_or_empty(p, sum_keys[s]), NULL);
+        if (k == 0)
+            snprintf(counters, sizeof counters, "%s", meta_or_empty(p, "murk:counters"));
+        else if (json_add(counters, sizeof counters, meta_or_empty(p, "murk:counters")) != 0)
+            counters[0] = 0; /* not of one shape: left out rather than wrong */
         if (k)
             murk_image_free(&img);
     }
@@ -176,6 +215,10 @@ int murk_cli_merge(int argc, char **argv)
             int skip = strncmp(key, "murk:", 5) != 0; /* the file's own attributes are the writer's */
             for (size_t s = 0; s < sizeof part_keys / sizeof part_keys[0]; s++)
                 skip |= !strcmp(key, part_keys[s]);
+            if (!strcmp(key, "murk:counters")) {
+                skip |= !counters[0];
+                val = counters;
+            }
             for (size_t s = 0; s < sizeof sum_keys / sizeof sum_keys[0]; s++)
                 if (!strcmp(key, sum_keys[s])) {
                     snprintf(vals[s], sizeof vals[s], strchr(val, '.') ? "%.3f" : "%.0f", sums[s]);
