@@ -365,8 +365,8 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    /* under mpirun, stderr is a pipe to the launcher but stdout stays the terminal (a pty) */
-    opts.progress = !quiet && (isatty(STDERR_FILENO) || (murk_mpi_launched() && isatty(STDOUT_FILENO)));
+    /* under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar */
+    opts.progress = !quiet && (isatty(STDERR_FILENO) || (getenv("MURK_PROGRESS") && !strcmp(getenv("MURK_PROGRESS"), "1")));
     char setbuf[4096] = "", ckid[4200], parttag[64] = "", fingerprint[4400];
     for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
         k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);

@@ -1,11 +1,15 @@
 /* mpi.c — murk's MPI calls (mpi_job.h); stubs of a job of one rank when built without MPI (MURK_HAVE_MPI
  * undefined). Sends are nonblocking (MPI_Isend from a buffer freed once delivered), so two ranks
- * sending to each other at once never wait for each other whatever the transport's eager limit. */
+ * sending to each other at once never wait for each other whatever the transport's eager limit. Every
+ * wait (a broadcast, a sum, the sends' delivery) tests and sleeps 0.2 ms between tests instead of
+ * blocking in MPI: Open MPI's blocking calls spin, and a rank spinning at the end of a pass would take
+ * a core from the render threads of a rank sharing its machine. */
 #include "mpi_job.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #ifdef MURK_HAVE_MPI
@@ -44,6 +48,19 @@ MURK_API const char *murk_mpi_host(void)
 }
 
 #ifdef MURK_HAVE_MPI
+
+/* Waits for r, sleeping between tests. */
+static void wait_for(MPI_Request *r)
+{
+    for (;;) {
+        int done = 0;
+        MPI_Test(r, &done, MPI_STATUS_IGNORE);
+        if (done)
+            return;
+        struct timespec ts = {0, 200 * 1000};
+        nanosleep(&ts, NULL);
+    }
+}
 
 typedef struct pending {
     MPI_Request req;
@@ -123,18 +140,23 @@ MURK_API int murk_mpi_agree(int ok, char *msg, size_t msglen, int *who)
 
 MURK_API void murk_mpi_bcast(void *buf, size_t n)
 {
-    if (g_size > 1)
-        MPI_Bcast(buf, (int)n, MPI_BYTE, 0, MPI_COMM_WORLD);
+    MPI_Request r;
+    if (g_size < 2)
+        return;
+    MPI_Ibcast(buf, (int)n, MPI_BYTE, 0, MPI_COMM_WORLD, &r);
+    wait_for(&r);
 }
 
 void murk_mpi_sum_u64(uint64_t *v, int n)
 {
+    MPI_Request r;
     if (g_size < 2)
         return;
     if (g_rank == 0)
-        MPI_Reduce(MPI_IN_PLACE, v, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+        MPI_Ireduce(MPI_IN_PLACE, v, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD, &r);
     else
-        MPI_Reduce(v, NULL, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD);
+        MPI_Ireduce(v, NULL, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD, &r);
+    wait_for(&r);
 }
 
 MURK_API int murk_mpi_max_int(int x)
@@ -195,7 +217,7 @@ void murk_mpi_recv(int from, int tag, void *buf, size_t n)
 void murk_mpi_flush(void)
 {
     for (size_t i = 0; i < g_npend; i++) {
-        MPI_Wait(&g_pend[i].req, MPI_STATUS_IGNORE);
+        wait_for(&g_pend[i].req);
         free(g_pend[i].buf);
     }
     g_npend = 0;

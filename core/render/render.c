@@ -59,6 +59,10 @@ typedef struct job {
     size_t nslots;
     murk_counters media[MURK_COUNTER_SLOTS];
     tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
+    /* rank 0 under MPI (MURK_MPI_STATS=1 prints them): tiles handed to other ranks, messages and bytes
+     * received and sent, seconds its main thread spent handling them, passes */
+    uint64_t mpi_tiles, mpi_msgs, mpi_bytes, mpi_passes;
+    double mpi_serve;
 } job;
 
 static void queue_init(tile_queue *q, int n)
@@ -237,9 +241,11 @@ static void tile_state(job *j, int t, unsigned char *p, int dir)
 static void hand_out(job *j, int to, int stopped, int *remote)
 {
     int k = stopped ? j->ntiles : atomic_fetch_add(&j->next, 1);
+    j->mpi_msgs++;
     if (k >= j->ntiles) {
         int32_t *end = murk_xmalloc(sizeof *end);
         murk_mpi_post(to, MURK_TAG_END, end, sizeof *end);
+        j->mpi_bytes += sizeof *end;
         return;
     }
     int t = j->tiles[k], state = j->spp0 > 0;
@@ -251,6 +257,16 @@ static void hand_out(job *j, int to, int stopped, int *remote)
         tile_state(j, t, msg + 16, 1);
     murk_mpi_post(to, MURK_TAG_TILE, msg, n);
     (*remote)++;
+    j->mpi_tiles++;
+    j->mpi_bytes += n;
+}
+
+/* CPU seconds of the calling thread (the overhead measurements: not inflated by preemption). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static void nap(void)
@@ -271,7 +287,10 @@ static void serve_pass(job *j, int progress, double t_start, int spp_total, int 
         int from, tag, busy = 0;
         size_t n;
         while (murk_mpi_poll(-1, &from, &tag, &n)) {
+            double t_msg = thread_cpu();
             busy = 1;
+            j->mpi_msgs++;
+            j->mpi_bytes += n;
             if (n > cap)
                 buf = murk_xrealloc(buf, cap = n);
             murk_mpi_recv(from, tag, buf, n);
@@ -288,6 +307,7 @@ static void serve_pass(job *j, int progress, double t_start, int spp_total, int 
             }
             for (; k > 0; k--)
                 hand_out(j, from, stopped, &remote);
+            j->mpi_serve += thread_cpu() - t_msg;
         }
         if (!stopped && j->stop && *j->stop) {
             stopped = 1;
@@ -411,9 +431,11 @@ MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk
 }
 
 /* Passes: with a time limit, stop signal or checkpoint, passes are sized to take about PASS_SECONDS (the
- * loss when a pass is abandoned, the granularity of checkpoints); otherwise one pass does every sample.
+ * loss when a pass is abandoned, the granularity of checkpoints), MPI_PASS_SECONDS under MPI, where every
+ * pass moves every tile's state twice; otherwise one pass does every sample.
  * Only whole passes count: a pass abandoned on a stop is rolled back from the copy taken before it. */
 #define PASS_SECONDS 0.5
+#define MPI_PASS_SECONDS 2.0
 
 MURK_API int murk_part_of(int w, int x, int y, int parts)
 {
@@ -576,6 +598,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
         }
         double tp = murk_now();
         send_passes(PASS_RUN, j.spp0, j.spp1);
+        j.mpi_passes++;
         run_pass(&j, nthreads, opts->progress, t0, spp - start, done - start);
         if (murk_mpi_size() > 1) { /* the other ranks' rays, NaNs and busy time of this pass */
             uint64_t v[3] = {0, 0, 0};
@@ -610,7 +633,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
                 break;
             pass = (int)(left / per_spp * 0.9); /* next pass fills most of what is left */
         } else if (adaptive) {
-            pass = (int)(PASS_SECONDS / (per_spp > 1e-9 ? per_spp : 1e-9));
+            pass = (int)((murk_mpi_size() > 1 ? MPI_PASS_SECONDS : PASS_SECONDS) / (per_spp > 1e-9 ? per_spp : 1e-9));
         }
         if (pass < 1)
             pass = 1;
@@ -628,6 +651,12 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
         progress_bar((double)(done - start) / (spp - start > 0 ? spp - start : 1), murk_now() - t0);
         fputc('\n', stderr);
     }
+    if (murk_mpi_size() > 1 && getenv("MURK_MPI_STATS")) /* the measured overheads bench/scaling.py models */
+        fprintf(stderr, "murk: mpi: %d ranks, %llu passes, %d tiles per pass, %llu tiles to other ranks, %llu "
+                "messages, %llu bytes, rank 0 handled them in %.6f CPU s (%.2f us per tile)\n", murk_mpi_size(),
+                (unsigned long long)j.mpi_passes, j.ntiles, (unsigned long long)j.mpi_tiles,
+                (unsigned long long)j.mpi_msgs, (unsigned long long)j.mpi_bytes, j.mpi_serve,
+                j.mpi_tiles ? 1e6 * j.mpi_serve / (double)j.mpi_tiles : 0.0);
     out->seconds = murk_now() - t0;
     out->spp = done;
     out->thread_seconds = (double)atomic_load(&j.busy_ns) * 1e-9;
