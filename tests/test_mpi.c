@@ -2,7 +2,7 @@
  * and 3 ranks is bitwise the single-process render, with the same rays and cost counters (summed over
  * the ranks); so are a render resumed by 3 ranks from the
  * checkpoint 2 ranks wrote, and a --time render (rank 0 decides the passes) against a single-process
- * render of the spp it reached. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
+ * render of the spp it reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
  * job with the located message naming that rank, a non-zero status and no image. Skipped (exit 77)
  * when murk is built without MPI or mpirun is missing. The ranks run on this machine, oversubscribed
  * (--oversubscribe), as root when need be (OMPI_ALLOW_RUN_AS_ROOT). */
@@ -111,6 +111,25 @@ static void time_limit_passes_are_rank0s(void **state)
     assert_same_pixels(tmp_path("timed.exr"), tmp_path("timed_single.exr"));
 }
 
+static void part_rendered_by_ranks(void **state)
+{
+    (void)state;
+    char *log = NULL;
+    const char *args[] = {"render", src_path(SCENE), "-o", tmp_path("part1.exr"), "--spp", SPP, "--set", RES,
+                          "--threads", "2", "--quiet", "--part", "1/3", NULL};
+    int rc = run_murk_argv(&log, args);
+    if (rc != 0)
+        fail_msg("murk render --part 1/3 failed (%d):\n%s", rc, log);
+    free(log);
+    const char *extra[] = {"--spp", SPP, "--part", "1/3", NULL};
+    rc = mpi_render(&log, 2, "part1_mpi.exr", extra);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 murk render --part 1/3 failed (%d):\n%s", rc, log);
+    free(log);
+    assert_same_pixels(tmp_path("part1_mpi.exr"), tmp_path("part1.exr"));
+    assert_string_equal(meta(tmp_path("part1_mpi.exr"), "murk:part"), "1/3");
+}
+
 static void error_on_one_rank_stops_the_job(void **state)
 {
     (void)state;
@@ -145,6 +164,7 @@ int main(void)
         cmocka_unit_test(ranks_give_the_single_process_image),
         cmocka_unit_test(resumed_by_other_ranks),
         cmocka_unit_test(time_limit_passes_are_rank0s),
+        cmocka_unit_test(part_rendered_by_ranks),
         cmocka_unit_test(error_on_one_rank_stops_the_job),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
