@@ -7,6 +7,7 @@
 #include "scene.h"
 #include "util.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -36,6 +37,7 @@ typedef struct job {
     pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
     size_t nslots;
     murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel of a finite sample */
 } job;
 
 static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
@@ -59,6 +61,7 @@ static void *worker(void *arg)
     const murk_scene *s = j->s;
     murk_host_thread_reset();
     uint64_t bad = 0;
+    float peak = 0.0f;
     for (;;) {
         if (j->stop && *j->stop) {
             if (atomic_load(&j->next) < j->ntiles)
@@ -87,6 +90,7 @@ static void *worker(void *arg)
                         continue;
                     }
                     acc[0] += L.c[0], acc[1] += L.c[1], acc[2] += L.c[2];
+                    peak = fmaxf(peak, fmaxf(fabsf(L.c[0]), fmaxf(fabsf(L.c[1]), fabsf(L.c[2]))));
                     n++;
                 }
                 j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];
@@ -98,6 +102,8 @@ static void *worker(void *arg)
     atomic_fetch_add(&j->nonfinite, bad);
     pthread_mutex_lock(&j->lock);
     murk_host_thread_counters_add(j->media, j->nslots);
+    if (peak > j->max_sample)
+        j->max_sample = peak;
     pthread_mutex_unlock(&j->lock);
     return NULL;
 }
@@ -290,6 +296,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
     out->nmedia = (int)j.nslots;
+    out->max_sample = j.max_sample;
     memcpy(out->media, j.media, sizeof j.media);
     pthread_mutex_destroy(&j.lock);
     free(j.sum);

@@ -39,6 +39,7 @@ typedef struct murk_render_result {
      * last one shared when the scene has more than MURK_COUNTER_SLOTS media. */
     int nmedia;
     murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel value of a finite sample (this run's): a sign of fireflies */
 } murk_render_result;
 
 /* `sets` are "KEY.PATH=VALUE" overrides. NULL with a one-line "file:line:col: message" in err. */
