@@ -221,7 +221,7 @@ static int check_vary_key(const murk_scene *s, const vary *v, char *err, size_t 
 {
     const murk_ynode *n = s->doc.root;
     char *path = murk_strdup(v->key), *save = NULL;
-    int rc = 0;
+    int rc = 0, line = 1, col = 1;
     const char *parent = "the scene";
     char *comp = strtok_r(path, ".", &save);
     while (comp) {
@@ -231,19 +231,24 @@ static int check_vary_key(const murk_scene *s, const vary *v, char *err, size_t 
         const murk_ynode *c = NULL;
         if (n && n->kind == MURK_Y_MAP) {
             for (size_t i = 0; i < n->n && !c; i++)
-                c = !strcmp(n->keys[i], comp) ? n->items[i] : NULL;
+                if (!strcmp(n->keys[i], comp)) {
+                    c = n->items[i];
+                    line = n->key_line[i], col = n->key_col[i]; /* where the key is written */
+                }
         } else if (n && n->kind == MURK_Y_SEQ) {
             char *end;
             long ix = strtol(comp, &end, 10);
             c = *comp && !*end && ix >= 0 && (size_t)ix < n->n ? n->items[ix] : NULL;
+            if (c)
+                line = c->line, col = c->col;
         }
         if (!c) {
             char have[512] = "";
             size_t k = 0;
             for (size_t i = 0; n && n->kind == MURK_Y_MAP && i < n->n && k < sizeof have; i++)
                 k += (size_t)snprintf(have + k, sizeof have - k, "%s%s", i ? ", " : "", n->keys[i]);
-            snprintf(err, errlen, "%s:%d:%d: --vary %s: %s has no '%s'%s%s%s", s->doc.file, n ? n->line : 1,
-                     n ? n->col : 1, murk_cli_q(v->key), parent, murk_cli_q(comp), *have ? " (it has: " : "",
+            snprintf(err, errlen, "%s:%d:%d: --vary %s: %s has no '%s'%s%s%s", s->doc.file, line, col,
+                     murk_cli_q(v->key), parent, murk_cli_q(comp), *have ? " (it has: " : "",
                      murk_cli_q(have), *have ? ")" : "");
             rc = -1;
             break;
