@@ -20,4 +20,7 @@ int murk_cli_bench(int argc, char **argv);   /* bench.c */
 void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n);
 void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r);
 
+/* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */
+int murk_cli_merge(int argc, char **argv);
+
 #endif

@@ -1,9 +1,21 @@
 /* render.c — tiles over a thread pool. Each (pixel, sample) has its own random stream seeded from
  * (seed, pixel, sample) and each pixel is accumulated by one thread in sample order, so the image is
- * bitwise identical for any thread count. Non-finite samples are counted and left out of the pixel. */
+ * bitwise identical for any thread count. Non-finite samples are counted and left out of the pixel.
+ *
+ * Under MPI (mpi_job.h) the same holds for any number of ranks. Rank 0 keeps every pixel's state and
+ * decides the passes (the sample ranges: --time, checkpoints and signals are its decisions alone, sent
+ * to every rank before each pass). Within a pass its threads take tiles from the shared counter and its
+ * main thread hands tiles out to the other ranks on request, one per request: a rank asks for as many
+ * tiles as it has threads plus one when the pass starts and for one more with each tile it returns, so
+ * a heavy tile holds up one thread, never a rank's queue. A tile travels with its pixels' sums and
+ * counts (none in a render's first pass) and comes back with them advanced by the pass's samples in
+ * sample order: no pixel is ever summed across ranks, so the sums are the single-process ones bit for
+ * bit. Messages per tile and pass: one TILE (16 bytes + 28 per pixel of state) and one RESULT (8 + 28
+ * per pixel). After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
 #include "checkpoint.h"
 #include "error.h"
 #include "host.h"
+#include "mpi_job.h"
 #include "scene.h"
 #include "util.h"
 
@@ -23,22 +35,92 @@
 
 enum { TILE = 16 };
 
+/* Tile numbers handed between a rank's main thread and its render threads (MPI ranks other than 0):
+ * each tile enters at most once per pass, so ntiles slots never overflow. */
+typedef struct tile_queue {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int *t;
+    int head, tail, closed;
+} tile_queue;
+
 typedef struct job {
     const murk_scene *s;
     int spp0, spp1; /* sample range of this pass */
     double *sum;    /* 3 per pixel */
     uint32_t *count;
     int tiles_x, ntiles;
+    const int *tiles; /* the ntiles tile numbers rendered (all, or one --part's) */
     atomic_int next;
     atomic_int done;
-    atomic_uint_fast64_t rays, nonfinite;
+    atomic_uint_fast64_t rays, nonfinite, busy_ns;
     volatile sig_atomic_t *stop; /* set: take no more tiles; the pass is abandoned */
     atomic_int abandoned;
     pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
     size_t nslots;
     murk_counters media[MURK_COUNTER_SLOTS];
     double max_sample; /* the largest channel of a finite sample */
+    tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
 } job;
+
+static void queue_init(tile_queue *q, int n)
+{
+    pthread_mutex_init(&q->mu, NULL);
+    pthread_cond_init(&q->cv, NULL);
+    q->t = murk_xmalloc((size_t)(n > 0 ? n : 1) * sizeof *q->t);
+    q->head = q->tail = q->closed = 0;
+}
+
+static void queue_free(tile_queue *q)
+{
+    pthread_mutex_destroy(&q->mu);
+    pthread_cond_destroy(&q->cv);
+    free(q->t);
+}
+
+static void queue_push(tile_queue *q, int t)
+{
+    pthread_mutex_lock(&q->mu);
+    q->t[q->tail++] = t;
+    pthread_cond_signal(&q->cv);
+    pthread_mutex_unlock(&q->mu);
+}
+
+/* The next tile, or -1 once the queue is empty and (wait) closed or (!wait) at once. */
+static int queue_pop(tile_queue *q, int wait)
+{
+    pthread_mutex_lock(&q->mu);
+    while (wait && q->head == q->tail && !q->closed)
+        pthread_cond_wait(&q->cv, &q->mu);
+    int t = q->head < q->tail ? q->t[q->head++] : -1;
+    pthread_mutex_unlock(&q->mu);
+    return t;
+}
+
+static void queue_close(tile_queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    q->closed = 1;
+    pthread_cond_broadcast(&q->cv);
+    pthread_mutex_unlock(&q->mu);
+}
+
+/* The next tile of this pass for a render thread, or -1 when there is none. */
+static int take_tile(job *j)
+{
+    if (j->inq)
+        return queue_pop(j->inq, 1);
+    int k = atomic_fetch_add(&j->next, 1);
+    return k < j->ntiles ? j->tiles[k] : -1;
+}
+
+static void tile_done(job *j, int t, double seconds)
+{
+    atomic_fetch_add(&j->busy_ns, (uint64_t)(seconds * 1e9));
+    if (j->outq)
+        queue_push(j->outq, t);
+    atomic_fetch_add(&j->done, 1);
+}
 
 static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
 {
@@ -68,9 +150,10 @@ static void *worker(void *arg)
                 atomic_store(&j->abandoned, 1);
             break;
         }
-        int t = atomic_fetch_add(&j->next, 1);
-        if (t >= j->ntiles)
+        int t = take_tile(j);
+        if (t < 0)
             break;
+        double t_tile = murk_now();
         int x0 = (t % j->tiles_x) * TILE, y0 = (t / j->tiles_x) * TILE;
         int x1 = x0 + TILE < s->width ? x0 + TILE : s->width, y1 = y0 + TILE < s->height ? y0 + TILE : s->height;
         for (int y = y0; y < y1; y++)
@@ -96,7 +179,7 @@ static void *worker(void *arg)
                 j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];
                 j->count[pix] = n;
             }
-        atomic_fetch_add(&j->done, 1);
+        tile_done(j, t, murk_now() - t_tile);
     }
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
@@ -120,21 +203,191 @@ static void progress_bar(double frac, double elapsed)
     fflush(stderr);
 }
 
-/* Renders samples [spp0, spp1) of every pixel on nthreads threads. */
-static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_total, int spp_before)
+/* ---- tiles between ranks ---------------------------------------------------------------------- */
+
+/* The pixel rectangle of tile t. */
+static void tile_rect(const job *j, int t, int *x0, int *y0, int *x1, int *y1)
+{
+    const murk_scene *s = j->s;
+    *x0 = (t % j->tiles_x) * TILE, *y0 = (t / j->tiles_x) * TILE;
+    *x1 = *x0 + TILE < s->width ? *x0 + TILE : s->width, *y1 = *y0 + TILE < s->height ? *y0 + TILE : s->height;
+}
+
+/* Bytes of a tile's state: 3 double sums and a uint32 count per pixel. */
+enum { PIX_BYTES = 3 * sizeof(double) + sizeof(uint32_t), TILE_BYTES = TILE * TILE * PIX_BYTES };
+
+/* Copies tile t's state to (dir > 0) or from (dir < 0) the buffer p, or clears it (dir == 0). */
+static void tile_state(job *j, int t, unsigned char *p, int dir)
+{
+    int x0, y0, x1, y1;
+    tile_rect(j, t, &x0, &y0, &x1, &y1);
+    for (int y = y0; y < y1; y++) {
+        size_t pix = (size_t)y * (size_t)j->s->width + (size_t)x0, n = (size_t)(x1 - x0);
+        double *sum = j->sum + 3 * pix;
+        uint32_t *count = j->count + pix;
+        if (dir > 0) {
+            memcpy(p, sum, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
+            memcpy(p, count, n * sizeof *count), p += n * sizeof *count;
+        } else if (dir < 0) {
+            memcpy(sum, p, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
+            memcpy(count, p, n * sizeof *count), p += n * sizeof *count;
+        } else {
+            memset(sum, 0, 3 * n * sizeof *sum);
+            memset(count, 0, n * sizeof *count);
+        }
+    }
+}
+
+/* Rank 0: answers one request of rank `to` with a tile (and its state, after the first pass) or, when
+ * there is none left or the pass is being abandoned, with END. */
+static void hand_out(job *j, int to, int stopped, int *remote)
+{
+    int k = stopped ? j->ntiles : atomic_fetch_add(&j->next, 1);
+    if (k >= j->ntiles) {
+        int32_t *end = murk_xmalloc(sizeof *end);
+        murk_mpi_post(to, MURK_TAG_END, end, sizeof *end);
+        return;
+    }
+    int t = j->tiles[k], state = j->spp0 > 0;
+    size_t n = 16 + (state ? TILE_BYTES : 0);
+    unsigned char *msg = murk_xmalloc(n);
+    int32_t hdr[4] = {t, state, 0, 0};
+    memcpy(msg, hdr, sizeof hdr);
+    if (state)
+        tile_state(j, t, msg + 16, 1);
+    murk_mpi_post(to, MURK_TAG_TILE, msg, n);
+    (*remote)++;
+}
+
+static void nap(void)
+{
+    struct timespec ts = {0, 200 * 1000};
+    nanosleep(&ts, NULL);
+}
+
+/* Rank 0's main thread during a pass: serves the other ranks' requests and results, draws the progress
+ * bar, and returns when every tile is done (or, once stopped, back) and every rank has been answered. */
+static void serve_pass(job *j, int progress, double t_start, int spp_total, int spp_before)
+{
+    int waiting = murk_mpi_size() - 1, remote = 0, stopped = 0;
+    size_t cap = 16 + TILE_BYTES;
+    unsigned char *buf = murk_xmalloc(cap);
+    double drawn = 0;
+    for (;;) {
+        int from, tag, busy = 0;
+        size_t n;
+        while (murk_mpi_poll(-1, &from, &tag, &n)) {
+            busy = 1;
+            if (n > cap)
+                buf = murk_xrealloc(buf, cap = n);
+            murk_mpi_recv(from, tag, buf, n);
+            int32_t k = 1;
+            if (tag == MURK_TAG_REQ) {
+                memcpy(&k, buf, sizeof k);
+                waiting--;
+            } else if (tag == MURK_TAG_RESULT) {
+                int32_t t;
+                memcpy(&t, buf, sizeof t);
+                tile_state(j, t, buf + 8, -1);
+                remote--;
+                atomic_fetch_add(&j->done, 1);
+            }
+            for (; k > 0; k--)
+                hand_out(j, from, stopped, &remote);
+        }
+        if (!stopped && j->stop && *j->stop) {
+            stopped = 1;
+            if (atomic_load(&j->next) < j->ntiles)
+                atomic_store(&j->abandoned, 1);
+        }
+        if (waiting == 0 && remote == 0 && (stopped || atomic_load(&j->done) >= j->ntiles))
+            break;
+        if (progress && murk_now() - drawn > 0.2) {
+            drawn = murk_now();
+            progress_bar(((double)spp_before + (double)(j->spp1 - j->spp0) * atomic_load(&j->done) / j->ntiles) /
+                         (double)spp_total, drawn - t_start);
+        }
+        if (!busy)
+            nap();
+    }
+    free(buf);
+    murk_mpi_flush();
+}
+
+/* The main thread of a rank other than 0 during a pass: asks for `ask` tiles, queues the tiles that
+ * come for its render threads, returns each rendered tile (which asks for the next) and returns when
+ * every request has been answered and every tile it got is back. */
+static void work_pass(job *j, int ask)
+{
+    int32_t *req = murk_xmalloc(sizeof *req);
+    *req = ask;
+    murk_mpi_post(0, MURK_TAG_REQ, req, sizeof *req);
+    int asked = ask, held = 0;
+    unsigned char *buf = murk_xmalloc(16 + TILE_BYTES);
+    for (;;) {
+        int from, tag, t, busy = 0;
+        size_t n;
+        while (murk_mpi_poll(0, &from, &tag, &n)) {
+            busy = 1;
+            murk_mpi_recv(0, tag, buf, n > 16 + TILE_BYTES ? 16 + TILE_BYTES : n);
+            asked--;
+            if (tag == MURK_TAG_TILE) {
+                int32_t hdr[4];
+                memcpy(hdr, buf, sizeof hdr);
+                tile_state(j, hdr[0], buf + 16, hdr[1] ? -1 : 0);
+                held++;
+                queue_push(j->inq, hdr[0]);
+            }
+        }
+        while ((t = queue_pop(j->outq, 0)) >= 0) {
+            busy = 1;
+            unsigned char *msg = murk_xmalloc(8 + TILE_BYTES);
+            int32_t hdr[2] = {t, 0};
+            memcpy(msg, hdr, sizeof hdr);
+            tile_state(j, t, msg + 8, 1);
+            murk_mpi_post(0, MURK_TAG_RESULT, msg, 8 + TILE_BYTES);
+            held--;
+            asked++;
+        }
+        if (asked == 0 && held == 0)
+            break;
+        if (!busy)
+            nap();
+    }
+    free(buf);
+    queue_close(j->inq);
+    murk_mpi_flush();
+}
+
+/* Renders samples [spp0, spp1) of every pixel on nthreads threads (under MPI: of this rank). */
+static void run_pass(job *j, int nthreads, int progress, double t_start, int spp_total, int spp_before)
 {
     atomic_store(&j->next, 0);
     atomic_store(&j->done, 0);
     atomic_store(&j->abandoned, 0);
+    if (j->inq) {
+        j->inq->head = j->inq->tail = j->inq->closed = 0;
+        j->outq->head = j->outq->tail = 0;
+    }
     pthread_t *th = murk_xmalloc((size_t)nthreads * sizeof *th);
     int started = 0;
     for (; started < nthreads; started++)
         if (pthread_create(&th[started], NULL, worker, j) != 0)
             break;
+    if (started == 0 && murk_mpi_size() > 1) {
+        fprintf(stderr, "murk: rank %d (%s): cannot start a render thread\n", murk_mpi_rank(), murk_mpi_host());
+        murk_mpi_abort(1);
+    }
     if (started == 0) {
         free(th);
         worker(j); /* no threads to be had: render here */
-    } else {
+        return;
+    }
+    if (j->inq)
+        work_pass(j, started + 1);
+    else if (murk_mpi_size() > 1)
+        serve_pass(j, progress, t_start, spp_total, spp_before);
+    else
         while (progress && atomic_load(&j->done) < j->ntiles && !(j->stop && *j->stop)) {
             double frac = ((double)spp_before + (double)(j->spp1 - j->spp0) * atomic_load(&j->done) / j->ntiles) /
                           (double)spp_total;
@@ -142,11 +395,9 @@ static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_
             struct timespec ts = {0, 200 * 1000 * 1000};
             nanosleep(&ts, NULL);
         }
-        for (int i = 0; i < started; i++)
-            pthread_join(th[i], NULL);
-        free(th);
-    }
-    return 0;
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    free(th);
 }
 
 /* Saves the state after `done` whole samples per pixel; 0 or -1 with err set. */
@@ -170,6 +421,74 @@ MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk
  * Only whole passes count: a pass abandoned on a stop is rolled back from the copy taken before it. */
 #define PASS_SECONDS 0.5
 
+MURK_API int murk_part_of(int w, int x, int y, int parts)
+{
+    int tiles_x = (w + TILE - 1) / TILE;
+    return parts > 0 ? ((y / TILE) * tiles_x + x / TILE) % parts : 0;
+}
+
+MURK_API int murk_part_tiles(int w, int h, int part, int parts)
+{
+    int n = ((w + TILE - 1) / TILE) * ((h + TILE - 1) / TILE);
+    return parts > 0 ? n / parts + (part < n % parts) : n;
+}
+
+/* What rank 0 sends every rank before each pass and at the end (cmd PASS_END: spp0 = the spp reached,
+ * spp1 = interrupted; PASS_FAIL: rank 0 failed before rendering). */
+typedef struct pass_msg {
+    int32_t cmd, spp0, spp1, pad;
+} pass_msg;
+enum { PASS_RUN = 1, PASS_END, PASS_FAIL };
+
+static void send_passes(int cmd, int spp0, int spp1)
+{
+    pass_msg pm = {cmd, spp0, spp1, 0};
+    if (murk_mpi_size() > 1)
+        murk_mpi_bcast(&pm, sizeof pm);
+}
+
+/* Collective at the end: the render threads and cost counters of every rank into rank 0's out and j. */
+static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
+{
+    enum { N = 1 + MURK_COUNTER_SLOTS * MURK_NCOUNTERS };
+    uint64_t v[N];
+    _Static_assert(sizeof j->media == MURK_COUNTER_SLOTS * MURK_NCOUNTERS * sizeof(uint64_t), "counters are uint64s");
+    v[0] = (uint64_t)nthreads;
+    memcpy(v + 1, j->media, sizeof j->media);
+    murk_mpi_sum_u64(v, N);
+    out->threads = (int)v[0];
+    memcpy(j->media, v + 1, sizeof j->media);
+}
+
+/* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end. */
+static int follow_passes(job *j, int nthreads, murk_render_result *out)
+{
+    tile_queue inq, outq;
+    queue_init(&inq, j->ntiles);
+    queue_init(&outq, j->ntiles);
+    j->inq = &inq, j->outq = &outq, j->stop = NULL;
+    pass_msg pm;
+    for (;;) {
+        murk_mpi_bcast(&pm, sizeof pm);
+        if (pm.cmd != PASS_RUN)
+            break;
+        j->spp0 = pm.spp0, j->spp1 = pm.spp1;
+        atomic_store(&j->rays, 0);
+        atomic_store(&j->nonfinite, 0);
+        atomic_store(&j->busy_ns, 0);
+        run_pass(j, nthreads, 0, 0, 1, 0);
+        uint64_t v[3] = {atomic_load(&j->rays), atomic_load(&j->nonfinite), atomic_load(&j->busy_ns)};
+        murk_mpi_sum_u64(v, 3);
+    }
+    queue_free(&inq);
+    queue_free(&outq);
+    if (pm.cmd == PASS_END)
+        sum_over_ranks(j, nthreads, out);
+    out->spp = pm.spp0;
+    out->interrupted = pm.spp1;
+    return pm.cmd == PASS_END ? 0 : -1;
+}
+
 MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, murk_render_result *out, char *err,
                              size_t errlen)
 {
@@ -189,30 +508,51 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     j.sum = murk_xmalloc(3 * npix * sizeof(double));
     j.count = murk_xmalloc(npix * sizeof(uint32_t));
     j.tiles_x = (s->width + TILE - 1) / TILE;
-    j.ntiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
+    int alltiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
+    int *tiles = murk_xmalloc((size_t)alltiles * sizeof *tiles);
+    size_t npix_rendered = 0;
+    for (int t = 0; t < alltiles; t++)
+        if (murk_part_of(s->width, (t % j.tiles_x) * TILE, (t / j.tiles_x) * TILE, opts->parts) == opts->part) {
+            int x0, y0, x1, y1;
+            tiles[j.ntiles++] = t;
+            tile_rect(&j, t, &x0, &y0, &x1, &y1);
+            npix_rendered += (size_t)(x1 - x0) * (size_t)(y1 - y0);
+        }
+    j.tiles = tiles;
     j.stop = opts->stop;
     atomic_init(&j.rays, 0);
     atomic_init(&j.nonfinite, 0);
+    atomic_init(&j.busy_ns, 0);
     atomic_init(&j.abandoned, 0);
     pthread_mutex_init(&j.lock, NULL);
     j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
+    out->width = s->width;
+    out->height = s->height;
+    out->ranks = murk_mpi_size();
+    if (murk_mpi_rank() > 0) {
+        int rc = follow_passes(&j, nthreads, out);
+        pthread_mutex_destroy(&j.lock);
+        free(j.sum);
+        free(j.count);
+        free(tiles);
+        return rc;
+    }
 
     int done = 0, rc = 0;
     uint64_t rays_before = 0;
     if (opts->resume) {
         murk_ckpt want = {.scene_hash = opts->scene_hash, .seed = s->seed, .width = s->width, .height = s->height,
                           .overrides = opts->overrides}, c;
-        if (murk_ckpt_load(opts->resume, &want, &c, err, errlen) != 0) {
-            free(j.sum);
-            free(j.count);
-            return -1;
-        }
-        if (c.spp > spp) {
+        if (murk_ckpt_load(opts->resume, &want, &c, err, errlen) == 0 && c.spp > spp) {
             murk_err_file(err, errlen, opts->resume, "the checkpoint has %d spp, more than the %d asked for", c.spp,
                           spp);
             murk_ckpt_free(&c);
+        }
+        if (err[0]) {
+            send_passes(PASS_FAIL, 0, 0);
             free(j.sum);
             free(j.count);
+            free(tiles);
             return -1;
         }
         memcpy(j.sum, c.sum, 3 * npix * sizeof(double));
@@ -241,7 +581,15 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
             memcpy(keep_count, j.count, npix * sizeof(uint32_t));
         }
         double tp = murk_now();
+        send_passes(PASS_RUN, j.spp0, j.spp1);
         run_pass(&j, nthreads, opts->progress, t0, spp - start, done - start);
+        if (murk_mpi_size() > 1) { /* the other ranks' rays, NaNs and busy time of this pass */
+            uint64_t v[3] = {0, 0, 0};
+            murk_mpi_sum_u64(v, 3);
+            atomic_fetch_add(&j.rays, v[0]);
+            atomic_fetch_add(&j.nonfinite, v[1]);
+            atomic_fetch_add(&j.busy_ns, v[2]);
+        }
         if (atomic_load(&j.abandoned)) { /* roll the partial pass back: only whole passes count */
             memcpy(j.sum, keep_sum, 3 * npix * sizeof(double));
             memcpy(j.count, keep_count, npix * sizeof(uint32_t));
@@ -276,6 +624,8 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
             pass = 2 * n + 1; /* grow gradually so the estimate can adapt */
     }
     out->interrupted = done < spp && opts->stop && *opts->stop;
+    send_passes(PASS_END, done, out->interrupted);
+    sum_over_ranks(&j, nthreads, out);
     if (rc == 0 && opts->checkpoint && save_checkpoint(s, opts, &j, done, err, errlen) != 0)
         rc = -1;
     free(keep_sum);
@@ -285,14 +635,13 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
         fputc('\n', stderr);
     }
     out->seconds = murk_now() - t0;
-    out->width = s->width;
-    out->height = s->height;
     out->spp = done;
+    out->thread_seconds = (double)atomic_load(&j.busy_ns) * 1e-9;
     out->rgb = murk_xmalloc(3 * npix * sizeof(float));
     for (size_t i = 0; i < npix; i++)
         for (int c = 0; c < 3; c++)
             out->rgb[3 * i + (size_t)c] = j.count[i] ? (float)(j.sum[3 * i + (size_t)c] / j.count[i]) : 0.0f;
-    out->samples = (uint64_t)(done - start) * npix;
+    out->samples = (uint64_t)(done - start) * npix_rendered;
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
     out->nmedia = (int)j.nslots;
@@ -301,5 +650,6 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     pthread_mutex_destroy(&j.lock);
     free(j.sum);
     free(j.count);
+    free(tiles);
     return rc;
 }
