@@ -1,13 +1,33 @@
-/* bench.c — the cost counters' text forms (the end-of-render summary and the EXR's murk:counters).
+/* bench.c — `murk bench SCENE.yaml`: renders every variant (the cross product of the --vary lists) at
+ * every budget (--spp or --time) with --repeat seeds, measures each render against a reference
+ * (metrics.c: the noise-corrected relMSE and the rest) and its work (the cost counters), writes
+ * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
+ * the charts and report.md. Also the counters' text forms (the end-of-render summary, murk:counters).
  * Part of the murk executable. */
 #include "cli.h"
+#include "image.h"
+#include "media.h"
+#include "metrics.h"
 #include "scene.h"
 #include "util.h"
 
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 static const char *const counter_names[MURK_NCOUNTERS] = MURK_COUNTER_NAMES;
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 static uint64_t counter_get(const murk_counters *c, int k)
 {
@@ -91,4 +111,853 @@ void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_res
                     k + 1 < MURK_NCOUNTERS ? "," : "");
     }
     fputc('\n', f);
+}
+
+/* ---- murk bench ---------------------------------------------------------------------------- */
+
+typedef struct vary {
+    const char *arg; /* KEY=V1,V2,... as given */
+    char *key;
+    char **vals;
+    int nvals;
+} vary;
+
+typedef struct bench {
+    const char *scene, *out, *reference;
+    const char **sets, **ref_sets;
+    size_t nsets, nref_sets;
+    vary *vary;
+    int nvary, nvariants;
+    double *budgets;
+    int nbudgets, time_mode, repeat, threads, ref_spp, charts;
+} bench;
+
+enum { REF_CHUNKS = 4 };
+
+static char **split_list(const char *s, int *n)
+{
+    char **v = NULL;
+    *n = 0;
+    for (const char *p = s;;) {
+        const char *c = strchr(p, ',');
+        size_t l = c ? (size_t)(c - p) : strlen(p);
+        v = murk_xrealloc(v, (size_t)(*n + 1) * sizeof *v);
+        v[*n] = murk_xmalloc(l + 1);
+        memcpy(v[*n], p, l);
+        v[*n][l] = 0;
+        (*n)++;
+        if (!c)
+            break;
+        p = c + 1;
+    }
+    return v;
+}
+
+static void free_list(char **v, int n)
+{
+    for (int i = 0; i < n; i++)
+        free(v[i]);
+    free(v);
+}
+
+/* Variant i's value index along --vary k (the last --vary varies fastest). */
+static int variant_value(const bench *b, int i, int k)
+{
+    for (int j = b->nvary - 1; j > k; j--)
+        i /= b->vary[j].nvals;
+    return i % b->vary[k].nvals;
+}
+
+/* "type=delta majorant_factor=4": each --vary key's last component and the variant's value. */
+static void variant_label(const bench *b, int i, char *buf, size_t n)
+{
+    size_t k = 0;
+    buf[0] = 0;
+    for (int j = 0; j < b->nvary && k < n; j++) {
+        const char *leaf = strrchr(b->vary[j].key, '.');
+        k += (size_t)snprintf(buf + k, n - k, "%s%s=%s", j ? " " : "", leaf ? leaf + 1 : b->vary[j].key,
+                              b->vary[j].vals[variant_value(b, i, j)]);
+    }
+    if (!b->nvary)
+        snprintf(buf, n, "scene");
+}
+
+/* The --set list of a render: the common sets, variant i's values (i < 0: the reference's sets) and
+ * the seed (seed < 0: the scene's). Strings are kept in store (freed by the caller). */
+static size_t render_sets(const bench *b, int i, long seed, const char **out, char **store, size_t *nstore)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < b->nsets; k++)
+        out[n++] = b->sets[k];
+    if (i < 0 && b->nref_sets) {
+        for (size_t k = 0; k < b->nref_sets; k++)
+            out[n++] = b->ref_sets[k];
+    } else {
+        for (int j = 0; j < b->nvary; j++) {
+            size_t l = strlen(b->vary[j].key) + strlen(b->vary[j].vals[variant_value(b, i < 0 ? 0 : i, j)]) + 2;
+            char *s = murk_xmalloc(l);
+            snprintf(s, l, "%s=%s", b->vary[j].key, b->vary[j].vals[variant_value(b, i < 0 ? 0 : i, j)]);
+            out[n++] = store[(*nstore)++] = s;
+        }
+    }
+    if (seed >= 0) {
+        char *s = murk_xmalloc(40);
+        snprintf(s, 40, "render.seed=%ld", seed);
+        out[n++] = store[(*nstore)++] = s;
+    }
+    return n;
+}
+
+static void free_store(char **store, size_t *n)
+{
+    for (size_t i = 0; i < *n; i++)
+        free(store[i]);
+    *n = 0;
+}
+
+/* A --vary key must name a place the scene has, all but its last component (the last may be a key the
+ * scene leaves at its default: media.smoke.majorant_factor). A located message otherwise. */
+static int check_vary_key(const murk_scene *s, const vary *v, char *err, size_t errlen)
+{
+    const murk_ynode *n = s->doc.root;
+    char *path = murk_strdup(v->key), *save = NULL;
+    int rc = 0, line = 1, col = 1;
+    const char *parent = "the scene";
+    char *comp = strtok_r(path, ".", &save);
+    while (comp) {
+        char *next = strtok_r(NULL, ".", &save);
+        if (!next)
+            break;
+        const murk_ynode *c = NULL;
+        if (n && n->kind == MURK_Y_MAP) {
+            for (size_t i = 0; i < n->n && !c; i++)
+                if (!strcmp(n->keys[i], comp)) {
+                    c = n->items[i];
+                    line = n->key_line[i], col = n->key_col[i]; /* where the key is written */
+                }
+        } else if (n && n->kind == MURK_Y_SEQ) {
+            char *end;
+            long ix = strtol(comp, &end, 10);
+            c = *comp && !*end && ix >= 0 && (size_t)ix < n->n ? n->items[ix] : NULL;
+            if (c)
+                line = c->line, col = c->col;
+        }
+        if (!c) {
+            char have[512] = "";
+            size_t k = 0;
+            for (size_t i = 0; n && n->kind == MURK_Y_MAP && i < n->n && k < sizeof have; i++)
+                k += (size_t)snprintf(have + k, sizeof have - k, "%s%s", i ? ", " : "", n->keys[i]);
+            snprintf(err, errlen, "%s:%d:%d: --vary %s: %s has no '%s'%s%s%s", s->doc.file, line, col,
+                     murk_cli_q(v->key), parent, murk_cli_q(comp), *have ? " (it has: " : "",
+                     murk_cli_q(have), *have ? ")" : "");
+            rc = -1;
+            break;
+        }
+        n = c;
+        parent = comp;
+        comp = next;
+    }
+    free(path);
+    return rc;
+}
+
+static murk_scene *load_with(const bench *b, const char *const *sets, size_t nsets, char *err, size_t errlen)
+{
+    return murk_scene_load(b->scene, sets, nsets, err, errlen);
+}
+
+/* Every --vary value alone, then every variant, loads: the located loader message and the --vary that
+ * caused it, before anything is rendered. */
+static int validate(const bench *b)
+{
+    char err[2048];
+    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    murk_scene *s = load_with(b, b->sets, b->nsets, err, sizeof err);
+    int rc = 0;
+    if (!s) {
+        fprintf(stderr, "%s\n", err);
+        free(sets);
+        return -1;
+    }
+    for (int j = 0; j < b->nvary && !rc; j++) {
+        if (check_vary_key(s, &b->vary[j], err, sizeof err)) {
+            fprintf(stderr, "%s\nmurk: bench: nothing was rendered\n", err);
+            rc = -1;
+            break;
+        }
+        for (int k = 0; k < b->vary[j].nvals && !rc; k++) {
+            char one[4096];
+            snprintf(one, sizeof one, "%s=%s", b->vary[j].key, b->vary[j].vals[k]);
+            size_t n = 0;
+            for (size_t q = 0; q < b->nsets; q++)
+                sets[n++] = b->sets[q];
+            sets[n++] = one;
+            murk_scene *t = load_with(b, sets, n, err, sizeof err);
+            if (!t) {
+                fprintf(stderr, "%s\nmurk: bench: in --vary %s (value '%s'); nothing was rendered\n", err,
+                        murk_cli_q(b->vary[j].arg), murk_cli_q(b->vary[j].vals[k]));
+                rc = -1;
+            }
+            murk_scene_free(t);
+        }
+    }
+    char *store[64];
+    size_t nstore = 0;
+    for (int i = -1; i < b->nvariants && !rc; i++) {
+        if (i < 0 && !b->nref_sets)
+            continue;
+        size_t n = render_sets(b, i, -1, sets, store, &nstore);
+        murk_scene *t = load_with(b, sets, n, err, sizeof err);
+        char label[1024];
+        variant_label(b, i < 0 ? 0 : i, label, sizeof label);
+        if (!t) {
+            fprintf(stderr, "%s\nmurk: bench: in %s%s%s; nothing was rendered\n", err, i < 0 ? "the reference's --ref-set" : "variant '",
+                    i < 0 ? "" : murk_cli_q(label), i < 0 ? "" : "'");
+            rc = -1;
+        } else if (t->width != s->width || t->height != s->height) {
+            fprintf(stderr, "murk: bench: %s has another resolution than the scene; nothing was rendered\n",
+                    i < 0 ? "the reference" : murk_cli_q(label));
+            rc = -1;
+        }
+        murk_scene_free(t);
+        free_store(store, &nstore);
+    }
+    murk_scene_free(s);
+    free(sets);
+    return rc;
+}
+
+/* ---- the reference ---- */
+
+static uint64_t fnv(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *c = p;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ c[i]) * 1099511628211ull;
+    return h;
+}
+
+static int mkdirs(const char *path)
+{
+    char *p = murk_strdup(path);
+    for (char *s = p + 1; *s; s++)
+        if (*s == '/') {
+            *s = 0;
+            mkdir(p, 0777);
+            *s = '/';
+        }
+    int rc = mkdir(p, 0777) == 0 || errno == EEXIST ? 0 : -1;
+    free(p);
+    return rc;
+}
+
+static void cache_dir(char *buf, size_t n)
+{
+    const char *d = getenv("MURK_CACHE_DIR"), *x = getenv("XDG_CACHE_HOME"), *h = getenv("HOME");
+    if (d && *d)
+        snprintf(buf, n, "%s", d);
+    else if (x && *x)
+        snprintf(buf, n, "%s/murk", x);
+    else
+        snprintf(buf, n, "%s/.cache/murk", h && *h ? h : "/tmp");
+}
+
+typedef struct reference {
+    int w, h;
+    float *rgb, *var; /* var: the variance of rgb's per-pixel mean; NULL if unknown */
+    char path[4096];
+    int reused, spp;
+    double seconds;
+} reference;
+
+static void ref_free(reference *r)
+{
+    free(r->rgb);
+    free(r->var);
+}
+
+static int read_exr(const char *path, int w, int h, float **out)
+{
+    murk_image im = {0};
+    char err[1024];
+    if (murk_exr_read(path, &im, err, sizeof err) || im.w != w || im.h != h) {
+        murk_image_free(&im);
+        return -1;
+    }
+    *out = im.rgb;
+    im.rgb = NULL;
+    murk_image_free(&im);
+    return 0;
+}
+
+/* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
+ * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
+ * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the scene file's content hash, the
+ * --set overrides, the spp and murk's version. */
+static int make_reference(const bench *b, reference *r)
+{
+    char err[2048], dir[3072];
+    uint64_t sh = murk_file_hash(b->scene, err, sizeof err);
+    if (!sh) {
+        fprintf(stderr, "%s\n", err);
+        return -1;
+    }
+    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    char *store[64];
+    size_t nstore = 0, n = render_sets(b, -1, -1, sets, store, &nstore);
+    uint64_t h = fnv(1469598103934665603ull, "murk bench reference 1", 23);
+    h = fnv(h, MURK_VERSION, sizeof MURK_VERSION);
+    h = fnv(h, &sh, sizeof sh);
+    h = fnv(h, &b->ref_spp, sizeof b->ref_spp);
+    for (size_t i = 0; i < n; i++)
+        h = fnv(h, sets[i], strlen(sets[i]) + 1);
+    cache_dir(dir, sizeof dir);
+    char var_path[4200];
+    snprintf(r->path, sizeof r->path, "%s/bench-ref-%016llx.exr", dir, (unsigned long long)h);
+    snprintf(var_path, sizeof var_path, "%s/bench-ref-%016llx-var.exr", dir, (unsigned long long)h);
+    r->spp = b->ref_spp;
+    if (read_exr(r->path, r->w, r->h, &r->rgb) == 0 && read_exr(var_path, r->w, r->h, &r->var) == 0) {
+        r->reused = 1;
+        free_store(store, &nstore);
+        free(sets);
+        return 0;
+    }
+    free(r->rgb);
+    r->rgb = NULL;
+    size_t np = (size_t)r->w * (size_t)r->h * 3;
+    double *s1 = calloc(np, sizeof *s1), *s2 = calloc(np, sizeof *s2);
+    int rc = s1 && s2 ? 0 : -1;
+    for (int c = 0; c < REF_CHUNKS && rc == 0; c++) {
+        char seed[40];
+        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
+        sets[n] = seed;
+        murk_scene *s = load_with(b, sets, n + 1, err, sizeof err);
+        murk_render_opts o = {.spp = (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, .threads = b->threads};
+        murk_render_result res;
+        if (!s) {
+            fprintf(stderr, "%s\n", err);
+            rc = -1;
+            break;
+        }
+        if (isatty(STDERR_FILENO))
+            fprintf(stderr, "\rmurk bench: reference chunk %d of %d (%d spp)...   ", c + 1, REF_CHUNKS, o.spp);
+        if (murk_render_err(s, &o, &res, err, sizeof err) != 0) {
+            fprintf(stderr, "murk: %s\n", err);
+            rc = -1;
+        } else {
+            for (size_t i = 0; i < np; i++) {
+                s1[i] += res.rgb[i];
+                s2[i] += (double)res.rgb[i] * res.rgb[i];
+            }
+            r->seconds += res.seconds;
+        }
+        free(res.rgb);
+        murk_scene_free(s);
+    }
+    if (isatty(STDERR_FILENO))
+        fputc('\n', stderr);
+    if (rc == 0) {
+        r->rgb = murk_xmalloc(np * sizeof(float));
+        r->var = murk_xmalloc(np * sizeof(float));
+        for (size_t i = 0; i < np; i++) {
+            double m = s1[i] / REF_CHUNKS, v = (s2[i] - s1[i] * m) / (REF_CHUNKS - 1);
+            r->rgb[i] = (float)m;
+            r->var[i] = (float)(fmax(v, 0.0) / REF_CHUNKS);
+        }
+        char spp[32];
+        snprintf(spp, sizeof spp, "%d", REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS));
+        murk_kv meta[] = {{"murk:scene", b->scene}, {"murk:spp", spp}, {"murk:version", MURK_VERSION},
+                          {"murk:bench", "reference: the mean of 4 chunks"}};
+        murk_kv vmeta[] = {{"murk:scene", b->scene}, {"murk:bench", "variance of the reference's per-pixel mean"}};
+        if (mkdirs(dir) != 0 || murk_exr_write(r->path, r->rgb, r->w, r->h, meta, 4, err, sizeof err) != 0 ||
+            murk_exr_write(var_path, r->var, r->w, r->h, vmeta, 2, err, sizeof err) != 0)
+            fprintf(stderr, "murk: warning: could not cache the reference in %s (%s); it will be rendered again "
+                    "next time\n", murk_cli_q(dir), errno ? strerror(errno) : err);
+    }
+    free(s1);
+    free(s2);
+    free_store(store, &nstore);
+    free(sets);
+    return rc;
+}
+
+/* ---- output ---- */
+
+static void json_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void csv_str(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"')
+            fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+/* A float32 .npy file of h x w values (numpy's format 1.0). */
+static int write_npy(const char *path, const float *v, int w, int h)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return -1;
+    char head[128];
+    int n = snprintf(head, sizeof head, "{'descr': '<f4', 'fortran_order': False, 'shape': (%d, %d), }", h, w);
+    int total = 10 + n + 1, pad = (64 - total % 64) % 64;
+    unsigned short hl = (unsigned short)(n + pad + 1);
+    fwrite("\x93NUMPY\x01\x00", 1, 8, f);
+    fputc(hl & 0xff, f);
+    fputc(hl >> 8, f);
+    fwrite(head, 1, (size_t)n, f);
+    for (int i = 0; i < pad; i++)
+        fputc(' ', f);
+    fputc('\n', f);
+    fwrite(v, sizeof(float), (size_t)w * (size_t)h, f);
+    return fclose(f) == 0 ? 0 : -1;
+}
+
+/* Where the chart script is: beside the build tree's murk (build/tools/), else installed. */
+static void script_path(char *buf, size_t n)
+{
+    const char *env = getenv("MURK_BENCH_SCRIPT");
+    if (env && *env) {
+        snprintf(buf, n, "%s", env);
+        return;
+    }
+    char exe[4096];
+    ssize_t l = n > sizeof exe + 64 ? readlink("/proc/self/exe", exe, sizeof exe - 1) : -1;
+    if (l > 0) {
+        exe[l] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash) {
+            *slash = 0;
+            snprintf(buf, n, "%s/../tools/bench_report.py", exe);
+            if (access(buf, R_OK) == 0)
+                return;
+        }
+    }
+    snprintf(buf, n, "%s", MURK_BENCH_SCRIPT_INSTALLED);
+}
+
+static void fmt_eta(double s, char *buf, size_t n)
+{
+    if (s >= 3600)
+        snprintf(buf, n, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
+    else if (s >= 60)
+        snprintf(buf, n, "%dm%02ds", (int)(s / 60), (int)fmod(s, 60));
+    else
+        snprintf(buf, n, "%.0fs", s);
+}
+
+static int parse_budgets(const char *opt, const char *v, int time_mode, bench *b)
+{
+    int n;
+    char **parts = split_list(v, &n);
+    free(b->budgets);
+    b->budgets = murk_xmalloc((size_t)n * sizeof *b->budgets);
+    b->nbudgets = n;
+    b->time_mode = time_mode;
+    int rc = 0;
+    for (int i = 0; i < n && !rc; i++) {
+        char *end;
+        double x = strtod(parts[i], &end);
+        if (!*parts[i] || *end || !(x > 0) || x > (time_mode ? 1e6 : 1e7) || (!time_mode && x != floor(x))) {
+            fprintf(stderr, "murk: %s needs a comma-separated list of %s, got '%s'\n", opt,
+                    time_mode ? "positive seconds" : "whole spp counts above 0", murk_cli_q(v));
+            rc = -1;
+        }
+        b->budgets[i] = x;
+    }
+    free_list(parts, n);
+    return rc;
+}
+
+/* ---- the runs ---- */
+
+static void shell_quoted(FILE *f, int argc, char **argv)
+{
+    fputs("murk bench", f);
+    for (int i = 0; i < argc; i++) {
+        int plain = *argv[i] != 0;
+        for (const char *p = argv[i]; *p; p++)
+            if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=.,/:+@%", *p))
+                plain = 0;
+        if (plain) {
+            fprintf(f, " %s", argv[i]);
+            continue;
+        }
+        fputs(" '", f);
+        for (const char *p = argv[i]; *p; p++)
+            fputs(*p == '\'' ? "'\\''" : (char[2]){*p, 0}, f);
+        fputc('\'', f);
+    }
+}
+
+/* bench.json: what the chart script needs besides bench.csv. */
+static int write_meta(const bench *b, const reference *r, int argc, char **argv, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return -1;
+    char cmd[65536];
+    FILE *m = fmemopen(cmd, sizeof cmd, "w");
+    if (m) {
+        shell_quoted(m, argc, argv);
+        fclose(m);
+    } else {
+        snprintf(cmd, sizeof cmd, "murk bench %s", b->scene);
+    }
+    fprintf(f, "{\n  \"command\": ");
+    json_str(f, cmd);
+    fprintf(f, ",\n  \"version\": \"%s\",\n  \"scene\": ", MURK_VERSION);
+    json_str(f, b->scene);
+    fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %ld,\n", b->time_mode ? "seconds" : "spp",
+            b->repeat, b->threads, sysconf(_SC_NPROCESSORS_ONLN));
+    fprintf(f, "  \"reference\": {\"path\": ");
+    json_str(f, b->reference ? b->reference : r->path);
+    fprintf(f, ", \"given\": %s, \"reused\": %s, \"spp\": %d, \"seconds\": %.3f, \"noise_estimated\": %s, \"sets\": [",
+            b->reference ? "true" : "false", r->reused ? "true" : "false", b->reference ? 0 : r->spp, r->seconds,
+            r->var ? "true" : "false");
+    for (size_t i = 0; i < b->nref_sets; i++) {
+        fputs(i ? ", " : "", f);
+        json_str(f, b->ref_sets[i]);
+    }
+    fprintf(f, "]},\n  \"sets\": [");
+    for (size_t i = 0; i < b->nsets; i++) {
+        fputs(i ? ", " : "", f);
+        json_str(f, b->sets[i]);
+    }
+    fprintf(f, "],\n  \"vary\": [");
+    for (int j = 0; j < b->nvary; j++) {
+        fputs(j ? ", " : "", f);
+        json_str(f, b->vary[j].key);
+    }
+    fprintf(f, "],\n  \"variants\": [");
+    for (int i = 0; i < b->nvariants; i++) {
+        char label[1024];
+        variant_label(b, i, label, sizeof label);
+        fputs(i ? ", " : "", f);
+        json_str(f, label);
+    }
+    fprintf(f, "]\n}\n");
+    return fclose(f) == 0 ? 0 : -1;
+}
+
+static int run_bench(const bench *b, int argc, char **argv)
+{
+    char err[2048], path[8192], tmp[8200];
+    murk_scene *s0 = load_with(b, b->sets, b->nsets, err, sizeof err);
+    if (!s0) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    reference r = {.w = s0->width, .h = s0->height};
+    murk_scene_free(s0);
+    if (b->reference) {
+        if (read_exr(b->reference, r.w, r.h, &r.rgb) != 0) {
+            fprintf(stderr, "murk: --reference %s: not a readable %dx%d EXR (the scene's resolution)\n",
+                    murk_cli_q(b->reference), r.w, r.h);
+            return 1;
+        }
+        printf("reference: %s (given; its own noise is not known, so relMSE is not corrected for it)\n",
+               murk_cli_q(b->reference));
+    } else {
+        if (make_reference(b, &r) != 0) {
+            ref_free(&r);
+            return 1;
+        }
+        if (r.reused)
+            printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
+                   murk_cli_q(r.path));
+        else
+            printf("reference: %s (rendered: %d spp in %d chunks, %.1f s; cached)\n", murk_cli_q(r.path),
+                   REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS, r.seconds);
+    }
+    fflush(stdout);
+    snprintf(path, sizeof path, "%s/bench.csv", b->out);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *csv = fopen(tmp, "w");
+    if (!csv) {
+        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(tmp), strerror(errno));
+        ref_free(&r);
+        return 1;
+    }
+    fprintf(csv, "variant,label,budget,seed,spp,seconds,rays");
+    for (int k = 0; k < MURK_NCOUNTERS; k++)
+        fprintf(csv, ",%s", counter_names[k]);
+    fprintf(csv, ",mse,relmse,relmse_se,relmse_raw,ref_noise,mare,nonfinite,max_sample\n");
+    int big = 0;
+    double total_w = 0, done_w = 0, t0 = now();
+    for (int i = 0; i < b->nbudgets; i++) {
+        if (b->budgets[i] > b->budgets[big])
+            big = i;
+        total_w += b->budgets[i] * b->repeat * b->nvariants;
+    }
+    size_t np = (size_t)r.w * (size_t)r.h;
+    float *pix = murk_xmalloc(np * sizeof(float));
+    double *maps = calloc(np * (size_t)b->nvariants, sizeof(double));
+    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    char *store[64];
+    size_t nstore = 0;
+    int rc = maps ? 0 : 1, count = 0, total = b->nbudgets * b->repeat * b->nvariants, tty = isatty(STDERR_FILENO);
+    for (int bi = 0; bi < b->nbudgets && !rc; bi++)
+        for (int k = 0; k < b->repeat && !rc; k++)
+            for (int v = 0; v < b->nvariants && !rc; v++) { /* variants innermost: A B A B, drift hits all */
+                char label[1024], eta[32] = "?";
+                variant_label(b, v, label, sizeof label);
+                if (done_w > 0)
+                    fmt_eta((now() - t0) / done_w * (total_w - done_w), eta, sizeof eta);
+                count++;
+                if (tty) {
+                    fprintf(stderr, "\r\033[K[%d/%d] %s  %s %g  seed %d  ETA %s", count, total, label,
+                            b->time_mode ? "time" : "spp", b->budgets[bi], 1 + k, eta);
+                    fflush(stderr);
+                }
+                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
+                murk_scene *s = load_with(b, sets, n, err, sizeof err);
+                free_store(store, &nstore);
+                if (!s) {
+                    fprintf(stderr, "\n%s\n", err);
+                    rc = 1;
+                    break;
+                }
+                murk_render_opts o = {.threads = b->threads};
+                if (b->time_mode) {
+                    o.time_limit = b->budgets[bi];
+                    o.spp = 1 << 24;
+                } else {
+                    o.spp = (int)b->budgets[bi];
+                }
+                murk_render_result res;
+                if (murk_render_err(s, &o, &res, err, sizeof err) != 0) {
+                    fprintf(stderr, "\nmurk: %s\n", err);
+                    rc = 1;
+                } else {
+                    murk_metrics m;
+                    murk_metrics_compute(res.rgb, r.rgb, r.var, r.w, (murk_crop){0, 0, r.w, r.h}, &m, pix);
+                    murk_counters t = counters_total(&res);
+                    fprintf(csv, "%d,", v);
+                    csv_str(csv, label);
+                    fprintf(csv, ",%g,%d,%d,%.6f,%llu", b->budgets[bi], 1 + k, res.spp, res.seconds,
+                            (unsigned long long)res.rays);
+                    for (int c = 0; c < MURK_NCOUNTERS; c++)
+                        fprintf(csv, ",%llu", (unsigned long long)counter_get(&t, c));
+                    fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m.mse, m.relmse, m.relmse_se,
+                            m.relmse_raw, m.ref_noise, m.mare, (unsigned long long)(res.nonfinite + m.nonfinite),
+                            res.max_sample);
+                    if (bi == big)
+                        for (size_t p = 0; p < np; p++)
+                            maps[(size_t)v * np + p] += isfinite(pix[p]) ? pix[p] / b->repeat : 0.0;
+                }
+                done_w += b->budgets[bi];
+                free(res.rgb);
+                murk_scene_free(s);
+                murk_warn_summary();
+            }
+    if (tty)
+        fprintf(stderr, "\r\033[K");
+    int closed = fclose(csv);
+    if (rc == 0 && (closed != 0 || rename(tmp, path) != 0)) {
+        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+        rc = 1;
+    }
+    if (rc)
+        remove(tmp);
+    /* the per-pixel maps of the largest budget, and the meta data */
+    snprintf(path, sizeof path, "%s/maps", b->out);
+    if (rc == 0 && mkdirs(path) != 0)
+        rc = 1;
+    for (int v = 0; v < b->nvariants && rc == 0; v++) {
+        for (size_t p = 0; p < np; p++)
+            pix[p] = (float)maps[(size_t)v * np + p];
+        snprintf(path, sizeof path, "%s/maps/variant%d.npy", b->out, v);
+        if (write_npy(path, pix, r.w, r.h) != 0) {
+            fprintf(stderr, "murk: cannot write %s\n", murk_cli_q(path));
+            rc = 1;
+        }
+    }
+    snprintf(path, sizeof path, "%s/bench.json", b->out);
+    if (rc == 0 && write_meta(b, &r, argc, argv, path) != 0) {
+        fprintf(stderr, "murk: cannot write %s\n", murk_cli_q(path));
+        rc = 1;
+    }
+    free(pix);
+    free(maps);
+    free(sets);
+    ref_free(&r);
+    if (rc == 0)
+        printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", total, b->nvariants,
+               b->nbudgets, b->repeat, now() - t0, b->out);
+    if (rc == 0 && b->charts) {
+        char script[8192], cmd[32768];
+        script_path(script, sizeof script);
+        const char *py = getenv("MURK_PYTHON");
+        if (!py || !*py)
+            py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+        snprintf(cmd, sizeof cmd, "'%s' '%s' '%s'", py, script, b->out);
+        if (strchr(py, '\'') || strchr(script, '\'') || strchr(b->out, '\'')) {
+            fprintf(stderr, "murk: the charts need paths without a ' in them\n");
+            return 1;
+        }
+        fflush(stdout);
+        int st = system(cmd);
+        if (st != 0) {
+            fprintf(stderr, "murk: the chart script failed (%s %s: status %d); bench.csv is complete. It needs "
+                    "python3 with matplotlib and numpy (Debian: python3-matplotlib python3-numpy)\n",
+                    murk_cli_q(py), murk_cli_q(script), st);
+            rc = 1;
+        }
+    }
+    return rc;
+}
+
+static const char bench_usage[] =
+    "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
+    "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
+    "                  [-o DIR] [--no-charts]\n";
+
+int murk_cli_bench(int argc, char **argv)
+{
+    bench b = {0};
+    b.repeat = 3;
+    b.charts = 1;
+    b.sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.sets);
+    b.ref_sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.ref_sets);
+    b.vary = murk_xmalloc((size_t)(argc + 1) * sizeof *b.vary);
+    int rc = 0;
+    long lv;
+    for (int i = 0; i < argc && !rc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int needs = strcmp(a, "--no-charts") && strcmp(a, "--help") && strcmp(a, "-h") && a[0] == '-';
+        if (needs && !v) {
+            fprintf(stderr, "murk: %s needs a value\n%s", murk_cli_q(a), bench_usage);
+            rc = 2;
+            break;
+        }
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            fputs(bench_usage, stdout);
+            rc = -1;
+        } else if (!strcmp(a, "--vary")) {
+            const char *eq = strchr(v, '=');
+            if (!eq || eq == v || !eq[1]) {
+                fprintf(stderr, "murk: --vary needs KEY.PATH=V1,V2,..., got '%s'\n", murk_cli_q(v));
+                rc = 2;
+            } else {
+                vary *x = &b.vary[b.nvary++];
+                x->arg = v;
+                x->key = murk_xmalloc((size_t)(eq - v) + 1);
+                memcpy(x->key, v, (size_t)(eq - v));
+                x->key[eq - v] = 0;
+                x->vals = split_list(eq + 1, &x->nvals);
+            }
+            i++;
+        } else if (!strcmp(a, "--set")) {
+            b.sets[b.nsets++] = v, i++;
+        } else if (!strcmp(a, "--ref-set")) {
+            b.ref_sets[b.nref_sets++] = v, i++;
+        } else if (!strcmp(a, "--spp") || !strcmp(a, "--time")) {
+            rc = parse_budgets(a, v, !strcmp(a, "--time"), &b) ? 2 : 0, i++;
+        } else if (!strcmp(a, "--repeat")) {
+            char *end;
+            lv = strtol(v, &end, 10);
+            if (*end || lv < 2 || lv > 1000) {
+                fprintf(stderr, "murk: --repeat needs a whole number in [2, 1000] (standard errors need 2 seeds)\n");
+                rc = 2;
+            }
+            b.repeat = (int)lv, i++;
+        } else if (!strcmp(a, "--ref-spp") || !strcmp(a, "--threads")) {
+            char *end;
+            lv = strtol(v, &end, 10);
+            if (*end || lv < (a[2] == 'r' ? REF_CHUNKS : 0) || lv > 1L << 24) {
+                fprintf(stderr, "murk: %s needs a whole number in [%d, %ld], got '%s'\n", a, a[2] == 'r' ? REF_CHUNKS : 0,
+                        1L << 24, murk_cli_q(v));
+                rc = 2;
+            }
+            *(a[2] == 'r' ? &b.ref_spp : &b.threads) = (int)lv, i++;
+        } else if (!strcmp(a, "--reference")) {
+            b.reference = v, i++;
+        } else if (!strcmp(a, "-o")) {
+            b.out = v, i++;
+        } else if (!strcmp(a, "--no-charts")) {
+            b.charts = 0;
+        } else if (a[0] == '-') {
+            fprintf(stderr, "murk: unknown bench option '%s'\n%s", murk_cli_q(a), bench_usage);
+            rc = 2;
+        } else if (!b.scene) {
+            b.scene = a;
+        } else {
+            fprintf(stderr, "murk: bench takes one scene\n%s", bench_usage);
+            rc = 2;
+        }
+    }
+    if (rc == 0 && !b.scene) {
+        fprintf(stderr, "murk: bench needs a scene\n%s", bench_usage);
+        rc = 2;
+    }
+    if (rc == 0 && b.reference && (b.ref_spp || b.nref_sets)) {
+        fprintf(stderr, "murk: --reference and --ref-spp/--ref-set exclude each other\n");
+        rc = 2;
+    }
+    if (rc == 0 && !b.nbudgets)
+        rc = parse_budgets("--spp", "4,16,64", 0, &b);
+    b.nvariants = 1;
+    for (int j = 0; j < b.nvary && rc == 0; j++) {
+        if ((double)b.nvariants * b.vary[j].nvals > 1000) {
+            fprintf(stderr, "murk: the --vary lists make more than 1000 variants\n");
+            rc = 2;
+        }
+        b.nvariants *= b.vary[j].nvals;
+        for (int k = 0; k < b.vary[j].nvals; k++)
+            if (!*b.vary[j].vals[k]) {
+                fprintf(stderr, "murk: --vary %s has an empty value\n", murk_cli_q(b.vary[j].arg));
+                rc = 2;
+            }
+    }
+    if (rc == 0 && !b.ref_spp) { /* default: 16 x the largest spp budget (equal time: 1024) */
+        double mx = 0;
+        for (int i = 0; i < b.nbudgets; i++)
+            mx = fmax(mx, b.budgets[i]);
+        b.ref_spp = b.time_mode ? 1024 : (int)fmin(fmax(16 * mx, 64), 1 << 24);
+    }
+    char outbuf[4096];
+    if (rc == 0) {
+        if (!b.out) {
+            const char *base = strrchr(b.scene, '/');
+            base = base ? base + 1 : b.scene;
+            snprintf(outbuf, sizeof outbuf, "bench-%.*s", (int)strcspn(base, "."), base);
+            b.out = outbuf;
+        }
+        murk_set_quiet(1);
+        if (validate(&b) != 0)
+            rc = 1;
+    }
+    if (rc == 0 && mkdirs(b.out) != 0) {
+        fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b.out), strerror(errno));
+        rc = 1;
+    }
+    if (rc == 0)
+        rc = run_bench(&b, argc, argv);
+    for (int j = 0; j < b.nvary; j++) {
+        free(b.vary[j].key);
+        free_list(b.vary[j].vals, b.vary[j].nvals);
+    }
+    free(b.vary);
+    free(b.sets);
+    free(b.ref_sets);
+    free(b.budgets);
+    return rc < 0 ? 0 : rc;
 }

@@ -35,6 +35,7 @@ static const char usage_text[] =
     "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
     "  murk plugins [NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+    "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
     "  murk --version\n";
@@ -735,6 +736,8 @@ int murk_cli_main(int argc, char **argv)
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return murk_cli_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "bench"))
+        return murk_cli_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "check"))
         return murk_check_main(argc - 1, argv + 1);
     if (!strcmp(cmd, "grid"))

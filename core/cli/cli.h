@@ -11,6 +11,7 @@ void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
 int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
+int murk_cli_bench(int argc, char **argv);   /* bench.c */
 
 /* The cost counters (murk/counters.h) of a render as JSON for the EXR's murk:counters, and as the
  * end-of-render summary's lines (bench.c). */

@@ -42,7 +42,7 @@ struct murk_density {
 typedef struct walk {
     murk_dda dda;
     float factor;
-    unsigned slot;
+    murk_counters *count; /* this thread's block for the medium (host.h), taken once per walk */
 } walk;
 
 _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
@@ -62,7 +62,7 @@ void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, 
     walk *k = (walk *)(void *)w;
     murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
     k->factor = d->factor;
-    k->slot = d->slot;
+    k->count = &murk_thread_counters[d->slot];
 }
 
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
@@ -70,7 +70,7 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     walk *k = (walk *)(void *)w;
     float mx = 0.0f, mn = 0.0f;
     int r = murk_dda_next(&k->dda, ta, tb, &mx, &mn);
-    murk_thread_counters[k->slot].cells += (unsigned)r;
+    k->count->cells += (unsigned)r;
     if (dmax)
         *dmax = mx * k->factor;
     if (dmin)

@@ -159,12 +159,16 @@ void murk_mpi_sum_u64(uint64_t *v, int n)
     wait_for(&r);
 }
 
-MURK_API int murk_mpi_max_int(int x)
+void murk_mpi_max_double(double *v)
 {
-    int y = x;
-    if (g_size > 1)
-        MPI_Allreduce(&x, &y, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    return y;
+    MPI_Request r;
+    if (g_size < 2)
+        return;
+    if (g_rank == 0)
+        MPI_Ireduce(MPI_IN_PLACE, v, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD, &r);
+    else
+        MPI_Ireduce(v, NULL, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD, &r);
+    wait_for(&r);
 }
 
 /* Frees the buffers of the sends that have been delivered. */
@@ -251,7 +255,7 @@ void murk_mpi_sum_u64(uint64_t *v, int n)
     (void)v;
     (void)n;
 }
-MURK_API int murk_mpi_max_int(int x) { return x; }
+void murk_mpi_max_double(double *v) { (void)v; }
 void murk_mpi_post(int dest, int tag, void *buf, size_t n)
 {
     (void)dest;

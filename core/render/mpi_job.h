@@ -38,8 +38,8 @@ MURK_API int murk_mpi_agree(int ok, char *msg, size_t msglen, int *who);
 MURK_API void murk_mpi_bcast(void *buf, size_t n);
 /* Collective: n integers summed over the ranks into rank 0's v (exact, in any order). */
 void murk_mpi_sum_u64(uint64_t *v, int n);
-/* Collective: the largest of every rank's x, on every rank. */
-MURK_API int murk_mpi_max_int(int x);
+/* Collective: the largest of every rank's *v into rank 0's *v. */
+void murk_mpi_max_double(double *v);
 /* The name of this host (for messages). */
 MURK_API const char *murk_mpi_host(void);
 

@@ -19,6 +19,7 @@
 #include "scene.h"
 #include "util.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -58,6 +59,7 @@ typedef struct job {
     pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
     size_t nslots;
     murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel of a finite sample */
     tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
     /* rank 0 under MPI (MURK_MPI_STATS=1 prints them): tiles handed to other ranks, messages and bytes
      * received and sent, seconds its main thread spent handling them, passes */
@@ -145,6 +147,7 @@ static void *worker(void *arg)
     const murk_scene *s = j->s;
     murk_host_thread_reset();
     uint64_t bad = 0;
+    float peak = 0.0f;
     for (;;) {
         if (j->stop && *j->stop) {
             if (atomic_load(&j->next) < j->ntiles)
@@ -174,6 +177,7 @@ static void *worker(void *arg)
                         continue;
                     }
                     acc[0] += L.c[0], acc[1] += L.c[1], acc[2] += L.c[2];
+                    peak = fmaxf(peak, fmaxf(fabsf(L.c[0]), fmaxf(fabsf(L.c[1]), fabsf(L.c[2]))));
                     n++;
                 }
                 j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];
@@ -185,6 +189,8 @@ static void *worker(void *arg)
     atomic_fetch_add(&j->nonfinite, bad);
     pthread_mutex_lock(&j->lock);
     murk_host_thread_counters_add(j->media, j->nslots);
+    if (peak > j->max_sample)
+        j->max_sample = peak;
     pthread_mutex_unlock(&j->lock);
     return NULL;
 }
@@ -463,7 +469,8 @@ static void send_passes(int cmd, int spp0, int spp1)
         murk_mpi_bcast(&pm, sizeof pm);
 }
 
-/* Collective at the end: the render threads and cost counters of every rank into rank 0's out and j. */
+/* Collective at the end: the render threads, cost counters and largest sample of every rank into rank 0's
+ * out and j. */
 static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
 {
     enum { N = 1 + MURK_COUNTER_SLOTS * MURK_NCOUNTERS };
@@ -474,6 +481,7 @@ static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
     murk_mpi_sum_u64(v, N);
     out->threads = (int)v[0];
     memcpy(j->media, v + 1, sizeof j->media);
+    murk_mpi_max_double(&j->max_sample);
 }
 
 /* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end. */
@@ -668,6 +676,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
     out->nmedia = (int)j.nslots;
+    out->max_sample = j.max_sample;
     memcpy(out->media, j.media, sizeof j.media);
     pthread_mutex_destroy(&j.lock);
     free(j.sum);

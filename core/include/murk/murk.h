@@ -43,6 +43,7 @@ typedef struct murk_render_result {
      * last one shared when the scene has more than MURK_COUNTER_SLOTS media. */
     int nmedia;
     murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel value of a finite sample (this run's): a sign of fireflies */
     /* The job (summed over MPI ranks): processes, render threads, seconds those threads spent in tiles. */
     int ranks, threads;
     double thread_seconds;
