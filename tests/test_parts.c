@@ -2,7 +2,9 @@
  * a scene with a medium, merged, are bitwise the single-process render (EXR pixels and PNG bytes) with
  * its rays and cost counters; a
  * missing part, a part of another scene, a part given twice, an interrupted-looking or whole image each
- * fail with a message naming the culprit, and leave no output. */
+ * fail with a message naming the culprit, and leave no output. And the other way to spread work over
+ * a batch scheduler (issue 13, item 3): `murk bench --emit-jobs`, its jobs run by a shell loop and
+ * assembled, gives the in-process bench's rows. */
 #include "image.h"
 #include "testutil.h"
 
@@ -173,8 +175,111 @@ static void part_options_are_checked(void **state)
     assert_false(exists(tmp_path("x.exr")));
 }
 
+/* The lines of a text file (malloc'd, NULL-terminated). */
+static char **read_lines(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("cannot read %s", path);
+    char **v = calloc(1024, sizeof *v), buf[16384];
+    int n = 0;
+    while (n < 1023 && fgets(buf, sizeof buf, f)) {
+        buf[strcspn(buf, "\n")] = 0;
+        v[n++] = strdup(buf);
+    }
+    fclose(f);
+    return v;
+}
+
+static void free_lines(char **v)
+{
+    for (int i = 0; v[i]; i++)
+        free(v[i]);
+    free(v);
+}
+
+/* A CSV row without its 6th column (seconds: the one that depends on the machine's speed). */
+static void drop_seconds(const char *row, char *out, size_t n)
+{
+    int col = 1;
+    size_t k = 0;
+    for (const char *p = row; *p && k + 1 < n; p++) {
+        if (*p == ',')
+            col++;
+        if (col != 6)
+            out[k++] = *p;
+    }
+    out[k] = 0;
+}
+
+/* murk bench --emit-jobs: the commands of jobs.txt, run one by one by a shell loop, then assemble.sh,
+ * give bench.csv rows equal to the in-process bench's but for the seconds; a missing render is named. */
+static void sweep_as_jobs_assembles_the_same_rows(void **state)
+{
+    (void)state;
+    const char *common[] = {"bench", src_path("scenes/cornell_smoke.yaml"), "--vary",
+                            "media.smoke.type=delta,spectral_mis", "--set", "render.resolution=[40,32]", "--spp",
+                            "2,4", "--repeat", "2", "--ref-spp", "8", "--threads", "2", "--no-charts", "-o", NULL,
+                            NULL, NULL, NULL};
+    char *log = NULL;
+    common[16] = tmp_path("bench_in");
+    int rc = run_murk_argv(&log, common);
+    if (rc != 0)
+        fail_msg("murk bench failed (%d):\n%s", rc, log);
+    free(log);
+    common[16] = tmp_path("bench_jobs");
+    common[17] = "--emit-jobs";
+    common[18] = tmp_path("jobs");
+    rc = run_murk_argv(&log, common);
+    if (rc != 0)
+        fail_msg("murk bench --emit-jobs failed (%d):\n%s", rc, log);
+    assert_contains(log, "12 renders as jobs");
+    free(log);
+    char **jobs = read_lines(tmp_path("jobs/jobs.txt")), **slurm = read_lines(tmp_path("jobs/slurm.sh"));
+    int nslurm = 0;
+    for (int i = 0; slurm[i]; i++)
+        nslurm += !strcmp(slurm[i], "#SBATCH --array=0-11");
+    assert_int_equal(nslurm, 1);
+    free_lines(slurm);
+    int n = 0;
+    for (; jobs[n]; n++) { /* the plain shell loop: while read line; do sh -c "$line"; done < jobs.txt */
+        const char *argv[] = {"/bin/sh", "-c", jobs[n], NULL};
+        rc = run_argv(&log, argv);
+        if (rc != 0)
+            fail_msg("job %d failed (%d): %s\n%s", n + 1, rc, jobs[n], log);
+        free(log);
+    }
+    assert_int_equal(n, 12); /* 4 reference chunks + 2 variants x 2 budgets x 2 seeds */
+    free_lines(jobs);
+    const char *assemble[] = {"/bin/sh", tmp_path("jobs/assemble.sh"), NULL};
+    rc = run_argv(&log, assemble);
+    if (rc != 0)
+        fail_msg("assemble.sh failed (%d):\n%s", rc, log);
+    free(log);
+    char **a = read_lines(tmp_path("bench_in/bench.csv")), **b = read_lines(tmp_path("bench_jobs/bench.csv"));
+    int rows = 0;
+    for (; a[rows] || b[rows]; rows++) {
+        char ra[4096], rb[4096];
+        if (!a[rows] || !b[rows])
+            fail_msg("bench.csv: %s has more rows", a[rows] ? "the in-process bench" : "the assembled one");
+        drop_seconds(a[rows], ra, sizeof ra);
+        drop_seconds(b[rows], rb, sizeof rb);
+        assert_string_equal(rb, ra);
+    }
+    assert_int_equal(rows, 1 + 8);
+    free_lines(a);
+    free_lines(b);
+    /* a render missing: the assembly names it and fails */
+    assert_int_equal(remove(tmp_path("jobs/renders/v1-b0-s1.exr")), 0);
+    rc = run_argv(&log, assemble);
+    assert_int_not_equal(rc, 0);
+    assert_contains(log, "v1-b0-s1.exr");
+    free(log);
+}
+
 int main(void)
 {
+    setenv("MURK_CACHE_DIR", tmp_path("cache"), 1); /* murk bench's reference cache: not the user's */
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(merged_parts_are_the_whole_image),
         cmocka_unit_test(missing_part_is_named),
@@ -182,6 +287,7 @@ int main(void)
         cmocka_unit_test(duplicated_part_is_named),
         cmocka_unit_test(whole_image_is_not_a_part),
         cmocka_unit_test(part_options_are_checked),
+        cmocka_unit_test(sweep_as_jobs_assembles_the_same_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

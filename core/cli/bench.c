@@ -130,6 +130,8 @@ typedef struct bench {
     int nvary, nvariants;
     double *budgets;
     int nbudgets, time_mode, repeat, threads, ref_spp, charts;
+    const char *jobs; /* --emit-jobs DIR or --assemble DIR */
+    int assemble;
 } bench;
 
 enum { REF_CHUNKS = 4 };
@@ -390,6 +392,81 @@ static int read_exr(const char *path, int w, int h, float **out)
     return 0;
 }
 
+/* ---- sweeps as jobs (--emit-jobs DIR, --assemble DIR) ---- */
+
+/* Where job (variant v, budget bi, seed k) writes its image; v < 0: reference chunk k. */
+static void job_out(const bench *b, int v, int bi, int k, char *buf, size_t n)
+{
+    if (v < 0)
+        snprintf(buf, n, "%s/renders/ref%d.exr", b->jobs, k);
+    else
+        snprintf(buf, n, "%s/renders/v%d-b%d-s%d.exr", b->jobs, v, bi, k);
+}
+
+/* The value of "NAME": N in a murk:counters JSON text (0 if absent). */
+static uint64_t json_u64(const char *json, const char *name)
+{
+    char key[64];
+    snprintf(key, sizeof key, "\"%s\": ", name);
+    const char *p = json ? strstr(json, key) : NULL;
+    return p ? strtoull(p + strlen(key), NULL, 10) : 0;
+}
+
+/* A job's image read back as murk_render_err would have returned it: pixels, spp, seconds, rays, the
+ * counters' totals (as one medium), NaN count and largest sample. 0, or -1 after a message naming it. */
+static int read_job(const char *path, int w, int h, murk_render_result *res)
+{
+    murk_image im = {0};
+    char err[1024];
+    memset(res, 0, sizeof *res);
+    if (murk_exr_read(path, &im, err, sizeof err) != 0 || im.w != w || im.h != h ||
+        !murk_image_meta(&im, "murk:counters") || strcmp(murk_image_meta(&im, "murk:interrupted"), "no") != 0) {
+        fprintf(stderr, "murk: %s\nmurk: %s: not the finished %dx%d render of its job (run it again: the line "
+                "of jobs.txt that writes it)\n", im.rgb ? "" : err, murk_cli_q(path), w, h);
+        murk_image_free(&im);
+        return -1;
+    }
+    const char *json = murk_image_meta(&im, "murk:counters"), *total = strstr(json, "\"total\": ");
+    uint64_t t[MURK_NCOUNTERS];
+    for (int k = 0; k < MURK_NCOUNTERS; k++)
+        t[k] = json_u64(total, counter_names[k]);
+    res->media[0] = (murk_counters){t[0], t[1], t[2], t[3], t[4]};
+    res->nmedia = 1;
+    res->rays = json_u64(json, "rays");
+    res->spp = atoi(murk_image_meta(&im, "murk:spp"));
+    res->seconds = strtod(murk_image_meta(&im, "murk:render_time"), NULL);
+    res->nonfinite = strtoull(murk_image_meta(&im, "murk:nonfinite_samples"), NULL, 10);
+    const char *mx = murk_image_meta(&im, "murk:max_sample");
+    res->max_sample = mx ? strtod(mx, NULL) : 0.0;
+    res->width = w, res->height = h;
+    res->rgb = im.rgb;
+    im.rgb = NULL;
+    murk_image_free(&im);
+    return 0;
+}
+
+/* Renders (or, --assemble, reads) one render of the bench. 0, or -1 after a message. */
+static int bench_render(const bench *b, int v, int bi, int k, const char *const *sets, size_t n,
+                        const murk_render_opts *o, int w, int h, murk_render_result *res)
+{
+    char err[2048], path[4200];
+    if (b->assemble) {
+        job_out(b, v, bi, k, path, sizeof path);
+        return read_job(path, w, h, res);
+    }
+    murk_scene *s = load_with(b, sets, n, err, sizeof err);
+    if (!s) {
+        fprintf(stderr, "\n%s\n", err);
+        memset(res, 0, sizeof *res);
+        return -1;
+    }
+    int rc = murk_render_err(s, o, res, err, sizeof err);
+    if (rc != 0)
+        fprintf(stderr, "\nmurk: %s\n", err);
+    murk_scene_free(s);
+    return rc ? -1 : 0;
+}
+
 /* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
  * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
  * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the scene file's content hash, the
@@ -416,7 +493,8 @@ static int make_reference(const bench *b, reference *r)
     snprintf(r->path, sizeof r->path, "%s/bench-ref-%016llx.exr", dir, (unsigned long long)h);
     snprintf(var_path, sizeof var_path, "%s/bench-ref-%016llx-var.exr", dir, (unsigned long long)h);
     r->spp = b->ref_spp;
-    if (read_exr(r->path, r->w, r->h, &r->rgb) == 0 && read_exr(var_path, r->w, r->h, &r->var) == 0) {
+    if (!b->assemble && read_exr(r->path, r->w, r->h, &r->rgb) == 0 &&
+        read_exr(var_path, r->w, r->h, &r->var) == 0) {
         r->reused = 1;
         free_store(store, &nstore);
         free(sets);
@@ -431,18 +509,11 @@ static int make_reference(const bench *b, reference *r)
         char seed[40];
         snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
         sets[n] = seed;
-        murk_scene *s = load_with(b, sets, n + 1, err, sizeof err);
         murk_render_opts o = {.spp = (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, .threads = b->threads};
         murk_render_result res;
-        if (!s) {
-            fprintf(stderr, "%s\n", err);
-            rc = -1;
-            break;
-        }
-        if (isatty(STDERR_FILENO))
+        if (isatty(STDERR_FILENO) && !b->assemble)
             fprintf(stderr, "\rmurk bench: reference chunk %d of %d (%d spp)...   ", c + 1, REF_CHUNKS, o.spp);
-        if (murk_render_err(s, &o, &res, err, sizeof err) != 0) {
-            fprintf(stderr, "murk: %s\n", err);
+        if (bench_render(b, -1, 0, c, sets, n + 1, &o, r->w, r->h, &res) != 0) {
             rc = -1;
         } else {
             for (size_t i = 0; i < np; i++) {
@@ -452,7 +523,6 @@ static int make_reference(const bench *b, reference *r)
             r->seconds += res.seconds;
         }
         free(res.rgb);
-        murk_scene_free(s);
     }
     if (isatty(STDERR_FILENO))
         fputc('\n', stderr);
@@ -588,23 +658,28 @@ static int parse_budgets(const char *opt, const char *v, int time_mode, bench *b
 
 /* ---- the runs ---- */
 
+/* " WORD" as a POSIX shell reads it back: plain, or in single quotes. */
+static void shell_word(FILE *f, const char *w)
+{
+    int plain = *w != 0;
+    for (const char *p = w; *p; p++)
+        if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=.,/:+@%", *p))
+            plain = 0;
+    if (plain) {
+        fprintf(f, " %s", w);
+        return;
+    }
+    fputs(" '", f);
+    for (const char *p = w; *p; p++)
+        fputs(*p == '\'' ? "'\\''" : (char[2]){*p, 0}, f);
+    fputc('\'', f);
+}
+
 static void shell_quoted(FILE *f, int argc, char **argv)
 {
     fputs("murk bench", f);
-    for (int i = 0; i < argc; i++) {
-        int plain = *argv[i] != 0;
-        for (const char *p = argv[i]; *p; p++)
-            if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=.,/:+@%", *p))
-                plain = 0;
-        if (plain) {
-            fprintf(f, " %s", argv[i]);
-            continue;
-        }
-        fputs(" '", f);
-        for (const char *p = argv[i]; *p; p++)
-            fputs(*p == '\'' ? "'\\''" : (char[2]){*p, 0}, f);
-        fputc('\'', f);
-    }
+    for (int i = 0; i < argc; i++)
+        shell_word(f, argv[i]);
 }
 
 /* bench.json: what the chart script needs besides bench.csv. */
@@ -728,13 +803,6 @@ static int run_bench(const bench *b, int argc, char **argv)
                     fflush(stderr);
                 }
                 size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                murk_scene *s = load_with(b, sets, n, err, sizeof err);
-                free_store(store, &nstore);
-                if (!s) {
-                    fprintf(stderr, "\n%s\n", err);
-                    rc = 1;
-                    break;
-                }
                 murk_render_opts o = {.threads = b->threads};
                 if (b->time_mode) {
                     o.time_limit = b->budgets[bi];
@@ -743,8 +811,9 @@ static int run_bench(const bench *b, int argc, char **argv)
                     o.spp = (int)b->budgets[bi];
                 }
                 murk_render_result res;
-                if (murk_render_err(s, &o, &res, err, sizeof err) != 0) {
-                    fprintf(stderr, "\nmurk: %s\n", err);
+                int failed = bench_render(b, v, bi, k, sets, n, &o, r.w, r.h, &res);
+                free_store(store, &nstore);
+                if (failed) {
                     rc = 1;
                 } else {
                     murk_metrics m;
@@ -765,7 +834,6 @@ static int run_bench(const bench *b, int argc, char **argv)
                 }
                 done_w += b->budgets[bi];
                 free(res.rgb);
-                murk_scene_free(s);
                 murk_warn_summary();
             }
     if (tty)
@@ -825,10 +893,137 @@ static int run_bench(const bench *b, int argc, char **argv)
     return rc;
 }
 
+/* One render as a command line of jobs.txt. */
+static void emit_job(const bench *b, FILE *jobs, const char *murk, const char *scene, const char *const *sets,
+                     size_t n, double budget, const char *out)
+{
+    char num[64], *line = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&line, &len);
+    if (!f) {
+        fprintf(stderr, "murk: out of memory\n");
+        exit(1);
+    }
+    shell_word(f, murk);
+    fputs(" render", f);
+    shell_word(f, scene);
+    for (size_t i = 0; i < n; i++) {
+        fputs(" --set", f);
+        shell_word(f, sets[i]);
+    }
+    if (b->time_mode && budget > 0) {
+        snprintf(num, sizeof num, "%g", budget);
+        fprintf(f, " --time %s --spp %d", num, 1 << 24);
+    } else {
+        fprintf(f, " --spp %d", (int)budget);
+    }
+    if (b->threads)
+        fprintf(f, " --threads %d", b->threads);
+    fputs(" --quiet -o", f);
+    shell_word(f, out);
+    fclose(f);
+    fprintf(jobs, "%s\n", line + 1); /* without shell_word's leading space */
+    free(line);
+}
+
+/* --emit-jobs DIR: every render of the bench (the reference's chunks first) as one line of DIR/jobs.txt,
+ * DIR/slurm.sh running line SLURM_ARRAY_TASK_ID + 1 as one task of a job array, and DIR/assemble.sh,
+ * this bench's command line with --assemble DIR, which reads the images back into bench.csv, the
+ * charts and the report as if the renders had run here. The jobs' paths are absolute. */
+static int emit_jobs(const bench *b, int argc, char **argv)
+{
+    char murk[4096], scene[4096], dir[4096], path[8192], out[8192];
+    ssize_t l = readlink("/proc/self/exe", murk, sizeof murk - 1);
+    if (l <= 0 || !realpath(b->scene, scene)) {
+        fprintf(stderr, "murk: cannot resolve the paths of murk and %s\n", murk_cli_q(b->scene));
+        return 1;
+    }
+    murk[l] = 0;
+    snprintf(path, sizeof path, "%s/renders", b->jobs);
+    if (mkdirs(path) != 0 || !realpath(b->jobs, dir)) {
+        fprintf(stderr, "murk: cannot create %s: %s\n", murk_cli_q(path), strerror(errno));
+        return 1;
+    }
+    bench jb = *b;
+    jb.jobs = dir;
+    snprintf(path, sizeof path, "%s/jobs.txt", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+        return 1;
+    }
+    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    char *store[64];
+    size_t nstore = 0;
+    int njobs = 0;
+    for (int c = 0; c < REF_CHUNKS && !b->reference; c++) {
+        char seed[40];
+        size_t n = render_sets(b, -1, -1, sets, store, &nstore);
+        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
+        sets[n++] = seed;
+        job_out(&jb, -1, 0, c, out, sizeof out);
+        emit_job(b, f, murk, scene, sets, n, (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, out);
+        free_store(store, &nstore);
+        njobs++;
+    }
+    for (int bi = 0; bi < b->nbudgets; bi++)
+        for (int k = 0; k < b->repeat; k++)
+            for (int v = 0; v < b->nvariants; v++) {
+                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
+                job_out(&jb, v, bi, k, out, sizeof out);
+                emit_job(b, f, murk, scene, sets, n, b->budgets[bi], out);
+                free_store(store, &nstore);
+                njobs++;
+            }
+    free(sets);
+    int bad = fclose(f) != 0;
+    snprintf(path, sizeof path, "%s/slurm.sh", dir);
+    if (!bad && (f = fopen(path, "w")) != NULL) {
+        fprintf(f, "#!/bin/sh\n# murk bench as a Slurm job array: one render per task (line TASK + 1 of jobs.txt).\n"
+                   "#   jid=$(sbatch --parsable slurm.sh)\n"
+                   "#   sbatch --dependency=afterok:$jid --wrap 'sh %s/assemble.sh'\n"
+                   "#SBATCH --job-name=murk-bench\n#SBATCH --array=0-%d\n"
+                   "exec sh -c \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" '%s/jobs.txt')\"\n", dir, njobs - 1, dir);
+        bad = fclose(f) != 0;
+    } else {
+        bad = 1;
+    }
+    snprintf(path, sizeof path, "%s/assemble.sh", dir);
+    if (!bad && (f = fopen(path, "w")) != NULL) {
+        char cwd[4096];
+        fprintf(f, "#!/bin/sh\n# Reads the renders of jobs.txt back into bench.csv, the charts and the report: the\n"
+                   "# bench's own command line, in its folder, with --assemble for --emit-jobs.\ncd");
+        shell_word(f, getcwd(cwd, sizeof cwd) ? cwd : ".");
+        fputs(" || exit 1\nexec", f);
+        shell_word(f, murk);
+        fputs(" bench", f);
+        for (int i = 0; i < argc; i++) {
+            if (!strcmp(argv[i], "--emit-jobs")) {
+                fputs(" --assemble", f);
+                shell_word(f, dir);
+                i++;
+            } else {
+                shell_word(f, argv[i]);
+            }
+        }
+        fputc('\n', f);
+        bad = fclose(f) != 0;
+    } else {
+        bad = 1;
+    }
+    if (bad) {
+        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+        return 1;
+    }
+    printf("%d renders as jobs: %s/jobs.txt (one command a line), %s/slurm.sh (sbatch: a job array); then "
+           "sh %s/assemble.sh\n", njobs, dir, dir, dir);
+    return 0;
+}
+
 static const char bench_usage[] =
     "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
     "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
-    "                  [-o DIR] [--no-charts]\n";
+    "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n";
 
 int murk_cli_bench(int argc, char **argv)
 {
@@ -892,6 +1087,12 @@ int murk_cli_bench(int argc, char **argv)
             b.reference = v, i++;
         } else if (!strcmp(a, "-o")) {
             b.out = v, i++;
+        } else if (!strcmp(a, "--emit-jobs") || !strcmp(a, "--assemble")) {
+            if (b.jobs) {
+                fprintf(stderr, "murk: --emit-jobs and --assemble are given once, not both\n%s", bench_usage);
+                rc = 2;
+            }
+            b.jobs = v, b.assemble = a[2] == 'a', i++;
         } else if (!strcmp(a, "--no-charts")) {
             b.charts = 0;
         } else if (a[0] == '-') {
@@ -944,6 +1145,10 @@ int murk_cli_bench(int argc, char **argv)
         murk_set_quiet(1);
         if (validate(&b) != 0)
             rc = 1;
+    }
+    if (rc == 0 && b.jobs && !b.assemble) {
+        rc = emit_jobs(&b, argc, argv);
+        rc = rc ? rc : -1;
     }
     if (rc == 0 && mkdirs(b.out) != 0) {
         fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b.out), strerror(errno));

@@ -417,7 +417,8 @@ static int render_main(int argc, char **argv)
     }
 
     char spp[32], seed[32], secs[32], nonfinite[32], plugins[4096], interrupted[96] = "no", spp_asked[32];
-    char ranks[32], threads[32], tsecs[32], hash[32], exposure[32], ntiles[32];
+    char ranks[32], threads[32], tsecs[32], hash[32], exposure[32], ntiles[32], maxsample[40];
+    snprintf(maxsample, sizeof maxsample, "%.17g", res.max_sample);
     murk_registry_describe(&s->reg, plugins, sizeof plugins);
     snprintf(spp, sizeof spp, "%d", res.spp);
     snprintf(spp_asked, sizeof spp_asked, "%d", opts.spp > 0 ? opts.spp : s->spp);
@@ -435,6 +436,7 @@ static int render_main(int argc, char **argv)
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
         {"murk:resumed_from", opts.resume ? opts.resume : ""}, {"murk:counters", counters},
+        {"murk:max_sample", maxsample}, /* the largest channel of a finite sample (murk bench --assemble) */
         /* the job: processes, render threads, seconds those threads spent in tiles (summed over ranks) */
         {"murk:ranks", ranks}, {"murk:threads", threads}, {"murk:thread_time", tsecs},
         /* a --part render: what murk merge checks and needs */

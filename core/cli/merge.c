@@ -9,7 +9,8 @@
  * and every I of 0..N-1 must be given exactly once; otherwise the error names the file (or the missing
  * part). Parts are read one at a time, so memory holds two images whatever N. The merged EXR carries
  * the first part's attributes with the times, NaN counts, ranks, threads and cost counters (the numbers
- * of murk:counters) summed over the parts — so its counters are the single-process render's — and
+ * of murk:counters) summed over the parts — so its counters are the single-process render's — the
+ * largest murk:max_sample, and
  * its PNG preview is written beside it as `render` does: both files or neither. */
 #include "cli.h"
 #include "atomic.h"
@@ -126,6 +127,8 @@ int murk_cli_merge(int argc, char **argv)
     const char **owner = NULL; /* the file given for each part index */
     double sums[sizeof sum_keys / sizeof sum_keys[0]] = {0};
     static char counters[16384]; /* murk:counters summed over the parts */
+    double max_sample = 0;         /* and the largest of their murk:max_sample */
+    char maxs[40];
     int n = 0, rc = 0;
     for (int k = 0; k < nparts && rc == 0; k++) {
         murk_image *p = k ? &img : &first;
@@ -187,6 +190,8 @@ int murk_cli_merge(int argc, char **argv)
                            p->rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x), 3 * sizeof(float));
         for (size_t s = 0; s < sizeof sum_keys / sizeof sum_keys[0]; s++)
             sums[s] += strtod(meta_or_empty(p, sum_keys[s]), NULL);
+        if (strtod(meta_or_empty(p, "murk:max_sample"), NULL) > max_sample)
+            max_sample = strtod(meta_or_empty(p, "murk:max_sample"), NULL);
         if (k == 0)
             snprintf(counters, sizeof counters, "%s", meta_or_empty(p, "murk:counters"));
         else if (json_add(counters, sizeof counters, meta_or_empty(p, "murk:counters")) != 0)
@@ -215,6 +220,10 @@ int murk_cli_merge(int argc, char **argv)
             int skip = strncmp(key, "murk:", 5) != 0; /* the file's own attributes are the writer's */
             for (size_t s = 0; s < sizeof part_keys / sizeof part_keys[0]; s++)
                 skip |= !strcmp(key, part_keys[s]);
+            if (!strcmp(key, "murk:max_sample")) {
+                snprintf(maxs, sizeof maxs, "%.17g", max_sample);
+                val = maxs;
+            }
             if (!strcmp(key, "murk:counters")) {
                 skip |= !counters[0];
                 val = counters;
