@@ -8,7 +8,10 @@ renders the scene in every configuration below, in interleaved rounds (A B C ...
 per configuration the median and the min-max spread over the rounds of: the render time murk reports
 (loading and MPI start-up excluded), the speed-up against one thread in the same round, and the CPU
 seconds (user + system of every process, mpirun's included) per million samples — the cost of the work
-itself, which preemption by other processes does not inflate. Configurations (ranks x threads):
+itself, which preemption by other processes does not inflate — and the share of the render threads'
+time spent inside tiles (murk:thread_time / (murk:threads x murk:render_time): 1 means no thread ever
+waited for work, so the speed-up is the threads' count wherever each gets a core). Configurations
+(ranks x threads):
 
     1x1, 1x2         plain `murk render --threads T` (the thread scaling 1 -> 2)
     mpi 1x2          mpirun -n 1 (MPI initialised, no other rank)
@@ -45,6 +48,19 @@ def children_cpu():
     return r.ru_utime + r.ru_stime
 
 
+def exr_attr(path, key):
+    """A string attribute of an EXR header (murk writes murk:* as 'string' attributes)."""
+    with open(path, "rb") as f:
+        head = f.read(1 << 16)
+    tag = key.encode() + b"\0string\0"
+    i = head.find(tag)
+    if i < 0:
+        return None
+    i += len(tag)
+    n = int.from_bytes(head[i:i + 4], "little")
+    return head[i + 4:i + 4 + n].decode()
+
+
 def run(cmd, env):
     """Runs cmd; returns (render seconds, samples, cpu seconds, wall seconds, stats dict, output)."""
     c0, w0 = children_cpu(), time.monotonic()
@@ -62,6 +78,11 @@ def run(cmd, env):
     if s:
         keys = ["ranks", "passes", "ntiles", "tiles", "messages", "bytes", "serve_cpu"]
         stats = {k: float(v) for k, v in zip(keys, s.groups())}
+    # the share of the render threads' time spent inside tiles: 1 = no thread ever waited for work
+    out = cmd[cmd.index("-o") + 1]
+    busy = float(exr_attr(out, "murk:thread_time")) / (int(exr_attr(out, "murk:threads")) * float(
+        exr_attr(out, "murk:render_time")))
+    stats["busy"] = busy
     return secs, w * h * spp, cpu, wall, stats, p.stdout
 
 
@@ -88,7 +109,9 @@ def model(t_px, serve_us, bytes_per_tile, nodes=64, threads=32, pass_s=2.0):
         e_tail = min(1.0, e_tail)
         pass_wall = max(pass_s, tau)
         master = ntiles * serve_us * 1e-6 / pass_wall   # rank 0's main thread: fraction of one core
-        e_master = 1.0 - master / (nodes * threads)     # that core taken from the job's render threads
+        # that core is taken from the job's render threads; beyond one core rank 0 cannot keep up and the
+        # job goes at the pace it hands tiles out
+        e_master = (1.0 - min(master, 1.0) / (nodes * threads)) * min(1.0, 1.0 / master)
         net_mb_s = ntiles * bytes_per_tile / pass_wall / 1e6
         lines.append("  %4dx%-4d %5d tiles, %5.1f tiles per thread per pass, tile %.3g s: efficiency %.0f%% "
                      "(pass tail %.0f%%, rank 0 busy %.1f%% of a core, %.0f MB/s through rank 0)"
@@ -131,24 +154,26 @@ def main():
 
     print("\n%s at %sx%s, %d spp, %d interleaved rounds on %d cores; median (min-max)\n"
           % (a.scene, w, h, a.spp, a.rounds, os.cpu_count()))
-    print("| ranks x threads | render s | speed-up vs 1x1 (per round) | CPU s per Msample | MPI: passes, tiles to other ranks, bytes per tile, rank-0 CPU us per tile |")
-    print("|---|---|---|---|---|")
+    print("| ranks x threads | render s | speed-up vs 1x1 (per round) | CPU s per Msample | threads busy (in tiles) | MPI: passes, tiles to other ranks, bytes per tile, rank-0 CPU us per tile |")
+    print("|---|---|---|---|---|---|")
     base = [x[0] for x in res["1x1"]]
     for name, ranks, threads, _ in configs:
         xs = res[name]
         secs = [x[0] for x in xs]
         speed = [b / s for b, s in zip(base, secs)]
         cpu = [x[2] / (x[1] / 1e6) for x in xs]
-        st = [x[4] for x in xs if x[4]]
+        st = [x[4] for x in xs if "tiles" in x[4]]
+        busy = [x[4]["busy"] for x in xs]
         mpi_s = "-"
         if st and st[0]["tiles"] > 0:
             mpi_s = "%d, %d, %.0f, %s" % (st[0]["passes"], st[0]["tiles"], st[0]["bytes"] / (2 * st[0]["tiles"]),
                                           med_spread([s["serve_cpu"] / s["tiles"] * 1e6 for s in st]))
-        print("| %s | %s | %s | %s | %s |" % (name, med_spread(secs), med_spread(speed), med_spread(cpu), mpi_s))
+        print("| %s | %s | %s | %s | %s | %s |" % (name, med_spread(secs), med_spread(speed), med_spread(cpu),
+                                                  med_spread(busy), mpi_s))
 
     # the model's inputs: one thread's CPU per sample, rank 0's CPU per remote tile, bytes per tile
     t_px = statistics.median([x[2] / x[1] for x in res["1x1"]])
-    st = [x[4] for x in res["mpi 2x1"] if x[4] and x[4]["tiles"] > 0]
+    st = [x[4] for x in res["mpi 2x1"] if x[4].get("tiles", 0) > 0]
     serve_us = statistics.median([s["serve_cpu"] / s["tiles"] * 1e6 for s in st])
     bytes_tile = 16 + 8 + 2 * TILE * TILE * (3 * 8 + 4)
     print("\nModel of 64 nodes x 32 threads (2 s passes, as murk sizes them under MPI):")

@@ -72,6 +72,8 @@ static void ranks_give_the_single_process_image(void **state)
         snprintf(want, sizeof want, "%d", ranks);
         assert_string_equal(meta(tmp_path(out), "murk:ranks"), want);
         assert_string_equal(meta(tmp_path(out), "murk:threads"), want);
+        assert_true(atof(meta(tmp_path(out), "murk:thread_time")) > 0);
+        assert_string_equal(meta(tmp_path(out), "murk:part"), "(none)");
         char counters[256]; /* rays and cost counters, summed over the ranks, are the single process's */
         snprintf(counters, sizeof counters, "%s", meta(tmp_path("single.exr"), "murk:counters"));
         assert_string_equal(meta(tmp_path(out), "murk:counters"), counters);

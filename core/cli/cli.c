@@ -449,7 +449,7 @@ static int render_main(int argc, char **argv)
     snprintf(hash, sizeof hash, "%016llx", (unsigned long long)opts.scene_hash);
     snprintf(exposure, sizeof exposure, "%.9g", (double)s->exposure);
     snprintf(ntiles, sizeof ntiles, "%d", murk_part_tiles(res.width, res.height, opts.part, opts.parts));
-    int nmeta = (int)(sizeof meta / sizeof meta[0]) - (opts.parts ? 0 : 6);
+    int nmeta = (int)(sizeof meta / sizeof meta[0]) - (opts.parts ? 0 : 5); /* the murk:part... keys last */
     char *png = png_path_for(outbuf);
     int rc = ck_failed ? 1 : 0;
     if (res.interrupted)
