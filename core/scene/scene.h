@@ -58,6 +58,7 @@ struct murk_scene {
     int width, height, spp;
     uint64_t seed;
     float exposure;
+    uint32_t sampler; /* MURK_SAMPLER_* (render.sampler) */
     /* camera */
     murk_vec3 cam_from, cam_at, cam_up;
     float fov;

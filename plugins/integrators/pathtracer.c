@@ -67,6 +67,17 @@ void murk_pt_destroy(void *self)
         pt->host->free(pt);
 }
 
+/* The sampler's slots (murk/math.h), in this order in every sample: 0 the camera jitter (the core),
+ * 1 the hero channel, then per scattering event d = 0, 1, ... (a surface or a medium vertex) five
+ * slots from PT_SLOT(d, 0): the light choice (1-D) and the point on the light (2-D) of NEE, the
+ * BSDF / phase direction (2-D), the BSDF's lobe choice (1-D, u[2] of a material's sample()) and the
+ * Russian roulette after the event (1-D). Trackers and transmittance estimators take their numbers
+ * from the PCG stream (murk_rng_float), outside the slots. */
+enum { PT_SLOT_HERO = 1 };
+enum { PT_SLOT_LIGHT_CHOICE, PT_SLOT_LIGHT_POINT, PT_SLOT_DIRECTION, PT_SLOT_LOBE, PT_SLOT_ROULETTE,
+       PT_SLOTS_PER_EVENT };
+#define PT_SLOT(depth, which) (2u + (uint32_t)(depth) * PT_SLOTS_PER_EVENT + (uint32_t)(which))
+
 /* ---- small helpers ------------------------------------------------------------------------- */
 
 static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
@@ -222,7 +233,10 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, murk_rng *rng)
 {
     const murk_host *h = pt->host;
-    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    float u[3];
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE));
+    u[0] = murk_sample_1d(rng);
+    murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
     if (!h->sample_light(scene, v->p, u, &ls))
         return;
@@ -279,7 +293,9 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     v.g = m->data->g;
     if (pt->nee)
         sample_light(pt, scene, st, &v, rng);
-    float u[2] = {murk_rng_float(rng), murk_rng_float(rng)}, pdf;
+    float u[2], pdf;
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
+    murk_sample_2d(rng, u);
     murk_vec3 wi = h->phase_sample(v.g, v.wo, u, &pdf);
     if (!(pdf > 0.0f))
         return PT_END;
@@ -324,7 +340,10 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         v.wo_local.z = 1e-6f;
     if (pt->nee)
         sample_light(pt, scene, st, &v, rng);
-    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    float u[3];
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
+    murk_sample_2d(rng, u);
+    u[2] = murk_sample_1d(rng); /* PT_SLOT_LOBE */
     murk_bsdf_sample bs;
     bs.eta = 1.0f; /* a material built before ABI 1.3 does not write it */
     if (!v.mat->vt->sample(v.mat->self, v.hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
@@ -371,7 +390,8 @@ static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
         murk_rgb b = st->beta;
         float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) * st->eta_scale / mean3(st->R);
         q = murk_maxf(0.05f, murk_minf(1.0f, q));
-        if (murk_rng_float(rng) >= q)
+        murk_sample_seek(rng, PT_SLOT(st->depth - 1, PT_SLOT_ROULETTE)); /* depth was counted up at the vertex */
+        if (murk_sample_1d(rng) >= q)
             return 0;
         st->beta = murk_rgb_scale(st->beta, 1.0f / q);
     }
@@ -385,7 +405,8 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
     path st = {0};
     st.beta = st.R = murk_rgb1(1.0f);
     st.eta_scale = 1.0f;
-    st.ctx.hero = (int)(murk_rng_float(rng) * 3.0f);
+    murk_sample_seek(rng, PT_SLOT_HERO);
+    st.ctx.hero = (int)(murk_sample_1d(rng) * 3.0f);
     if (st.ctx.hero > 2)
         st.ctx.hero = 2;
     st.medium = pt->media ? h->camera_medium(scene) : NULL;

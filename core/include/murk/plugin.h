@@ -23,7 +23,8 @@
  * host->size before calling a host service appended after 1.0.
  * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version; 1.2 adds the transmittance
  * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
- * (the hit a material gets has n on wo's side, murk/material.h). Anything else — a changed signature,
+ * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends the sampler to murk_rng
+ * (murk_sample_1d/2d, murk/math.h). Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -53,7 +54,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 3
+#define MURK_ABI_MINOR 4
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
