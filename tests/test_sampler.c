@@ -2,9 +2,12 @@
  * stratified in every slot, differ per pixel and per seed, integrate a disk faster than independent
  * numbers; the independent sampler is the PCG stream in call order; renders with sobol are bitwise
  * identical for 1 and 2 threads, for --time passes and for a checkpoint resumed; render.sampler is
- * read and checked like every scene key. */
+ * read and checked like every scene key. And the solid-angle sampling of rectangular lights
+ * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
 #include "testutil.h"
+#include "host.h"
 #include "image.h"
+#include "scene.h"
 
 #include "murk/math.h"
 
@@ -290,6 +293,123 @@ static void test_scene_key(void **state)
     free(log);
 }
 
+
+/* ---- light sampling ------------------------------------------------------------------------ */
+
+/* MURK_LIGHT_SOLID_ANGLE on a tilted rectangular light seen from a far, a near and a grazing point:
+ * 200k samples binned 16 x 16 over the rectangle's (a, b) coordinates against the expected counts
+ * N * integral over the bin of pdf(w) dw = N * sum pdf cos_l / d^2 dA (32 x 32 midpoints per bin);
+ * p >= 1e-4, the expected counts sum to N (the pdf integrates to 1) and every sample's pdf equals
+ * light_pdf_with() at its point. */
+static void test_rect_light_chi2(void **state)
+{
+    (void)state;
+    const char *text = "murk: 1\n"
+                       "render: { resolution: [8, 8] }\n"
+                       "camera: { from: [0, 1, 4], at: [0, 1, 0], up: [0, 1, 0], fov: 30 }\n"
+                       "materials: { m: { type: diffuse, albedo: 0.5 } }\n"
+                       "shapes:\n"
+                       "  - { type: quad, center: [0.3, 2, -0.2], u: [0.4, 0.1, 0], v: [0, 0, 0.3], material: m, emission: [4, 3, 2] }\n";
+    char err[512];
+    murk_scene *s = murk_scene_load(write_tmp("rect.yaml", text), NULL, 0, err, sizeof err);
+    if (!s)
+        fail_msg("%s", err);
+    const murk_host *h = murk_host_table();
+    assert_true(MURK_HAS(h->size, murk_host, light_pdf_with));
+    const murk_vec3 c = murk_v3(0.3f, 2.0f, -0.2f), u = murk_v3(0.4f, 0.1f, 0.0f), v = murk_v3(0.0f, 0.0f, 0.3f);
+    const murk_vec3 p0 = murk_sub(murk_sub(c, u), v), ex = murk_mul(u, 2.0f), ey = murk_mul(v, 2.0f);
+    const murk_vec3 n = murk_normalize(murk_cross(ex, ey));
+    const double area = murk_length(murk_cross(ex, ey));
+    static const float pts[][3] = {{0.0f, 0.5f, 0.0f}, {0.35f, 1.85f, -0.1f}, {1.2f, 1.95f, 0.3f}};
+    enum { NB = 16, SUB = 32, N = 200000 };
+    for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
+        murk_vec3 p = murk_v3(pts[k][0], pts[k][1], pts[k][2]);
+        assert_true(murk_dot(murk_sub(p, p0), n) > 0.0f); /* on the emitting side */
+        static double obs[NB * NB], expct[NB * NB];
+        memset(obs, 0, sizeof obs);
+        memset(expct, 0, sizeof expct);
+        murk_rng rng;
+        murk_rng_seed(&rng, 15, k, 0);
+        long bad_pdf = 0;
+        for (long i = 0; i < N; i++) {
+            float uu[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};
+            murk_light_sample ls;
+            assert_true(h->sample_light_with(s, p, uu, MURK_LIGHT_SOLID_ANGLE, &ls));
+            murk_vec3 q = murk_madd(p, ls.wi, ls.dist), d = murk_sub(q, p0);
+            double a = murk_dot(d, ex) / murk_dot(ex, ex), b = murk_dot(d, ey) / murk_dot(ey, ey);
+            assert_true(a > -1e-4 && a < 1.0 + 1e-4 && b > -1e-4 && b < 1.0 + 1e-4);
+            int ia = (int)(a * NB), ib = (int)(b * NB);
+            ia = ia < 0 ? 0 : (ia >= NB ? NB - 1 : ia);
+            ib = ib < 0 ? 0 : (ib >= NB ? NB - 1 : ib);
+            obs[ia * NB + ib] += 1.0;
+            murk_hit hit = {0};
+            hit.p = q;
+            hit.light = 0;
+            float pdf = h->light_pdf_with(s, p, &hit, MURK_LIGHT_SOLID_ANGLE);
+            bad_pdf += fabsf(pdf - ls.pdf) > 1e-4f * ls.pdf;
+        }
+        double total = 0.0;
+        for (int ia = 0; ia < NB * SUB; ia++)
+            for (int ib = 0; ib < NB * SUB; ib++) {
+                double a = (ia + 0.5) / (NB * SUB), b = (ib + 0.5) / (NB * SUB);
+                murk_vec3 q = murk_add(p0, murk_add(murk_mul(ex, (float)a), murk_mul(ey, (float)b)));
+                murk_vec3 d = murk_sub(q, p);
+                double d2 = murk_dot(d, d), cosl = -murk_dot(n, d) / sqrt(d2);
+                murk_hit hit = {0};
+                hit.p = q;
+                hit.light = 1;
+                double dA = area / ((double)NB * SUB * NB * SUB);
+                double e = h->light_pdf_with(s, p, &hit, MURK_LIGHT_SOLID_ANGLE) * cosl / d2 * dA;
+                expct[(ia / SUB) * NB + ib / SUB] += N * e;
+                total += e;
+            }
+        int dof;
+        double pv = chi2_test(obs, expct, NB * NB, 5.0, &dof);
+        printf("rectangle light from (%.2f, %.2f, %.2f): chi2 p = %.4f (%d dof), integral of pdf %.5f, "
+               "%ld pdf mismatches\n", p.x, p.y, p.z, pv, dof, total, bad_pdf);
+        assert_true(pv >= 1e-4);
+        assert_true(fabs(total - 1.0) < 2e-3);
+        assert_int_equal(bad_pdf, 0);
+    }
+    murk_scene_free(s);
+}
+
+/* ---- the expected image ------------------------------------------------------------------------ */
+
+/* The new defaults (sobol, solid-angle light sampling) against murk before them (independent, area):
+ * two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree, |z| <= 4.5
+ * per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
+static void test_same_image(void **state)
+{
+    (void)state;
+    static const char *const medium[] = {"--set", "media.smoke.density={constant: 1}", "--set",
+                                         "media.smoke.sigma_a=[0.05, 0.1, 0.3]", "--set",
+                                         "media.smoke.sigma_s=[1.2, 0.8, 0.4]", NULL};
+    struct { const char *label, *scene, *spp; const char *const *extra; } cases[] = {
+        {"cornell", "scenes/cornell.yaml", "256", NULL},
+        {"cornell_smoke", "scenes/cornell_smoke.yaml", "64", NULL},
+        {"constant chromatic medium", "scenes/cornell_smoke.yaml", "64", medium},
+    };
+    int nfail = 0;
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *a_args[24] = {"--set", "render.resolution=[32,32]", "--spp", cases[i].spp}, *b_args[24];
+        size_t n = 4;
+        for (size_t k = 0; cases[i].extra && cases[i].extra[k]; k++)
+            a_args[n++] = cases[i].extra[k];
+        memcpy(b_args, a_args, sizeof a_args);
+        b_args[n] = "--set", b_args[n + 1] = "render.sampler=independent";
+        b_args[n + 2] = "--set", b_args[n + 3] = "integrator.light_sampling=area", b_args[n + 4] = NULL;
+        a_args[n] = NULL;
+        img_stack a, b;
+        img_stack_render(&a, src_path(cases[i].scene), "new.exr", 6, 10, a_args);
+        img_stack_render(&b, src_path(cases[i].scene), "old.exr", 6, 1000, b_args);
+        nfail += !img_stack_agree(cases[i].label, &a, &b, 4, 4.5);
+        img_stack_free(&a);
+        img_stack_free(&b);
+    }
+    assert_int_equal(nfail, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -297,8 +417,10 @@ int main(void)
         cmocka_unit_test(test_decorrelated),
         cmocka_unit_test(test_independent_is_pcg),
         cmocka_unit_test(test_disk_convergence),
+        cmocka_unit_test(test_rect_light_chi2),
         cmocka_unit_test(test_scene_key),
         cmocka_unit_test(test_render_bitwise),
+        cmocka_unit_test(test_same_image),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -22,6 +22,8 @@ const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
                            "most scattering events (surface or medium) per path"},
     [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000,
                           "scattering events before Russian roulette may end a path"},
+    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "solid_angle", "solid_angle|area", 0, 0,
+                                "NEE: rectangular lights by solid angle, or every light triangle by area"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -54,6 +56,7 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->host = host;
     pt->max_depth = (int)params[MURK_PT_MAX_DEPTH].f[0];
     pt->rr_depth = (int)params[MURK_PT_RR_DEPTH].f[0];
+    pt->light_strategy = params[MURK_PT_LIGHT_SAMPLING].choice == 0 ? MURK_LIGHT_SOLID_ANGLE : MURK_LIGHT_AREA;
     pt->nee = nee;
     pt->media = media;
     *self = pt;
@@ -238,7 +241,7 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
-    if (!h->sample_light(scene, v->p, u, &ls))
+    if (!h->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
         return;
     murk_rgb f = vertex_f(h, v, ls.wi);
     if (!finite3(f)) {
@@ -316,7 +319,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     murk_vec3 wo = murk_neg(st->ray.d);
     murk_rgb le = murk_hit_le(hit, wo);
     if (!murk_rgb_is_black(le))
-        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf(scene, st->prev_p, hit))
+        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy))
                                                      : 1.0f);
     if (st->depth >= pt->max_depth)
         return 0;

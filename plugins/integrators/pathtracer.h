@@ -34,7 +34,7 @@
 #include "murk/medium.h"
 
 /* The parameters all three integrators share (documented in each plugin's comment block). */
-enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_NPARAMS };
+enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 
 typedef struct murk_pt {
@@ -42,6 +42,7 @@ typedef struct murk_pt {
     int max_depth, rr_depth;
     int nee;   /* sample lights at every scattering vertex */
     int media; /* track media (0: surfaces only, boundaries are invisible) */
+    int light_strategy; /* MURK_LIGHT_* for NEE and the MIS weight of emission found (0: area) */
 } murk_pt;
 
 /* create() for an integrator with the given strategy; destroy() for all of them. */

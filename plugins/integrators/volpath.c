@@ -5,6 +5,11 @@
  * Parameters
  *   max_depth  int in [1, 100000], default 64: most scattering events (surface or medium) per path.
  *   rr_depth   int in [0, 100000], default 3: events before Russian roulette may end a path.
+ *   light_sampling  solid_angle | area, default solid_angle: how next-event estimation picks a point on
+ *              a light: a rectangular quad or box face uniformly in the solid angle it subtends (Urena et
+ *              al. 2013; tiny ones and other shapes as with area), or every emitting triangle uniformly
+ *              by area (murk before ABI 1.4). The same image either way; solid_angle is less noisy near
+ *              lights.
  *
  * Works with every tracker; see pathtracer.h (pathtracer.c) for how media, boundaries and spectral MIS weights
  * are handled. */
