@@ -24,6 +24,8 @@ const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
                           "scattering events before Russian roulette may end a path"},
     [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "solid_angle", "solid_angle|area", 0, 0,
                                 "NEE: rectangular lights by solid angle, or every light triangle by area"},
+    [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1,
+                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -57,6 +59,7 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->max_depth = (int)params[MURK_PT_MAX_DEPTH].f[0];
     pt->rr_depth = (int)params[MURK_PT_RR_DEPTH].f[0];
     pt->light_strategy = params[MURK_PT_LIGHT_SAMPLING].choice == 0 ? MURK_LIGHT_SOLID_ANGLE : MURK_LIGHT_AREA;
+    pt->rr_threshold = (float)params[MURK_PT_RR_THRESHOLD].f[0];
     pt->nee = nee;
     pt->media = media;
     *self = pt;
@@ -384,14 +387,18 @@ static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
     return 1;
 }
 
-/* After rr_depth events a path survives with probability q = max_c |beta_c| eta_scale / mean(R) (at
- * least 0.05, at most 1) and is divided by it (eta_scale: a path inside glass is not culled for the
- * 1 / eta^2 its radiance weight carries there). Returns 0 when the path ends. */
+/* After rr_depth events a path survives with probability q = max_c |beta_c| eta_scale / mean(R) /
+ * rr_threshold (at least 0.05, at most 1) and is divided by it (eta_scale: a path inside glass is not
+ * culled for the 1 / eta^2 its radiance weight carries there). rr_threshold 1 plays roulette with every
+ * path whose weight fell below 1; 0.1 (Tungsten's rule) only with the paths below a tenth. Returns 0 when
+ * the path ends. */
 static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
 {
     if (st->depth > pt->rr_depth) {
         murk_rgb b = st->beta;
         float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) * st->eta_scale / mean3(st->R);
+        if (pt->rr_threshold > 0.0f)
+            q /= pt->rr_threshold;
         q = murk_maxf(0.05f, murk_minf(1.0f, q));
         murk_sample_seek(rng, PT_SLOT(st->depth - 1, PT_SLOT_ROULETTE)); /* depth was counted up at the vertex */
         if (murk_sample_1d(rng) >= q)
