@@ -163,10 +163,11 @@ static void *worker(void *arg)
                 uint32_t n = j->count[pix];
                 for (int k = j->spp0; k < j->spp1; k++) {
                     murk_rng rng;
-                    murk_rng_seed(&rng, s->seed, pix, (uint64_t)k);
-                    float jx = murk_rng_float(&rng), jy = murk_rng_float(&rng);
+                    float jit[2]; /* slot 0 of the sampler (murk/math.h) */
+                    murk_sampler_start(&rng, s->sampler, s->seed, pix, (uint32_t)k);
+                    murk_sample_2d(&rng, jit);
                     murk_ray r;
-                    camera_ray(s, (float)x + jx, (float)y + jy, &r);
+                    camera_ray(s, (float)x + jit[0], (float)y + jit[1], &r);
                     murk_rgb L = s->integrator_vt->li(s->integrator, s, &r, &rng);
                     if (!murk_rgb_finite(L)) {
                         bad++;
