@@ -72,6 +72,53 @@ def heatmaps(root, rows, sweep, title):
     return rel
 
 
+def repair_section(meta):
+    L = ["## Where a majorant or control is wrong", ""]
+    L.append(
+        "A majorant below the density (`majorant_factor` < 1) or a decomposition control above it used to "
+        "weight every violating collision by up to 2a - 1 (a = density / majorant), multiplied along every "
+        "path: unbiased, but relMSE 1e19 (factor 0.5) and 1e43 (control 5) on cornell_smoke. Now:")
+    L.append("")
+    L.append(
+        "- **The core repairs the majorant before rendering** (`majorant_repair: true`, the default). murk's "
+        "majorant grid holds, per cell, the exact maximum of the interpolated field (density.h; the cloud and "
+        "the grids are voxel data, so the maximum is attained at a voxel), so a factor < 1 leaves every cell "
+        "with density below the density somewhere in it, and the repair gives each such cell its exact bound "
+        "back: the majorant of factor 1. It depends on the scene only, so the image stays a pure function of "
+        "(scene, seed, spp) for any thread count and tiling — a majorant raised at run time and shared between "
+        "threads would not. The warning names the cells (e.g. `majorant_factor 0.5 < 1 leaves 1657 of 3136 "
+        "majorant cells below the density; murk raised them to their exact bound before rendering (as "
+        "majorant_factor 1: no bias, no extra noise, the time of a bounding majorant ...)`).")
+    L.append(
+        "- **decomposition clamps its control** to each cell's minimum density (`repair: true`, the default): "
+        "control > 1 acts as 1, the largest control that stays below the density everywhere; its shadow rays "
+        "always use the clamped control (ratio tracking cannot undo an overshooting closed-form control "
+        "without exponentially heavy weights: |z| 17 in tests/test_stability.c before that change).")
+    L.append(
+        "- **With the repairs off** (`majorant_repair: false`, `repair: false`, or a third-party tracker whose "
+        "majorants are estimated) a tracker weights the violating collision and then tracks the rest of the "
+        "FLIGHT with the majorant raised 2x the excess (`murk_collisions_raise` in murk/tracking.h; "
+        "decomposition also lowers the flight's control below the density seen; ratio tracking raises its "
+        "majorant per ray). That is unbiased — the null-collision identity holds for any majorant over the "
+        "rest of the segment, which is estimated afresh after each collision — and per path, from the path's "
+        "own random numbers. It bounds the weight of one flight (the largest |weight| over 200000 "
+        "flights at factor 0.25 in tests/test_stability.c: 7 to 77; 240 to 37700 with the raise disabled), but a path has no state that outlives a flight, "
+        "so every flight of a long path may pay one violation again: the image is far better than before but "
+        "still unusable at factor 0.5 (table). That mode is for diagnosis; the repairs are the default.")
+    L.append("")
+    v = meta.get("violations") or []
+    if v:
+        L.append("relMSE at equal spp (96x96, 32 spp) against a 256-spp `spectral_mis` render with another seed; "
+                 "the bounding rows are the target (within 3x):")
+        L.append("")
+        L.append("| scene | variant | relMSE | time s |")
+        L.append("|---|---|---|---|")
+        for r in v:
+            L.append("| %s | %s | %.3g | %.2f |" % (r["scene"], r["variant"], r["relmse"], r["seconds"]))
+        L.append("")
+    return L
+
+
 def write(root, meta, rows, sweep_doc, prose=None):
     sweeps = []
     for r in rows:
@@ -112,9 +159,10 @@ def write(root, meta, rows, sweep_doc, prose=None):
     L.append("Per point and method, from every sample of the render (murk's hidden `MURK_SAMPLE_DUMP`):")
     L.append("")
     L.append("- **non-finite**: samples that are NaN or infinite (murk drops them from the pixel; must be 0);")
-    L.append("- **max/mean**: the largest sample's luminance over its pixel's mean (the largest single-sample "
-             "weight, as the image sees it);")
-    L.append("- **firefly rate**: the share of samples whose luminance exceeds 100x their pixel's mean;")
+    L.append("- **max/mean**: the largest sample's luminance over its pixel's mean in the reference (the largest "
+             "single-sample weight, as the image sees it; the reference's mean, because a pixel's own mean at n "
+             "spp can never be exceeded more than n-fold; floored at 1% of the image's mean);")
+    L.append("- **firefly rate**: the share of samples whose luminance exceeds 100x that pixel mean;")
     L.append("- **relvar**: mean over pixels of Var(pixel mean) / (mean^2 + 0.01), from the samples' own variance;")
     L.append("- **time**: murk's render time (wall clock, loaded machine); no density-lookup counts yet (the "
              "`murk:counters` metadata is another branch's work);")
@@ -126,6 +174,7 @@ def write(root, meta, rows, sweep_doc, prose=None):
              "bounding majorant (`majorant_factor` max(1, f)) and `control` 1 at 4x the spp and another seed — "
              "the most robust tracker in the atlas: its weights stay bounded for every chroma.")
     L.append("")
+    L += repair_section(meta)
     if prose:
         L += prose
     for sw in sweeps:
