@@ -65,6 +65,8 @@ typedef struct job {
      * received and sent, seconds its main thread spent handling them, passes */
     uint64_t mpi_tiles, mpi_msgs, mpi_bytes, mpi_passes;
     double mpi_serve;
+    float *dump; /* MURK_SAMPLE_DUMP: every sample's RGB, [pixel][sample][3], non-finite ones too */
+    int dump_spp;
 } job;
 
 static void queue_init(tile_queue *q, int n)
@@ -167,11 +169,14 @@ static void *worker(void *arg)
                 uint32_t n = j->count[pix];
                 for (int k = j->spp0; k < j->spp1; k++) {
                     murk_rng rng;
-                    murk_rng_seed(&rng, s->seed, pix, (uint64_t)k);
-                    float jx = murk_rng_float(&rng), jy = murk_rng_float(&rng);
+                    float jit[2]; /* slot 0 of the sampler (murk/math.h) */
+                    murk_sampler_start(&rng, s->sampler, s->seed, pix, (uint32_t)k);
+                    murk_sample_2d(&rng, jit);
                     murk_ray r;
-                    camera_ray(s, (float)x + jx, (float)y + jy, &r);
+                    camera_ray(s, (float)x + jit[0], (float)y + jit[1], &r);
                     murk_rgb L = s->integrator_vt->li(s->integrator, s, &r, &rng);
+                    if (j->dump && k < j->dump_spp)
+                        memcpy(j->dump + 3 * (pix * (size_t)j->dump_spp + (size_t)k), L.c, sizeof L.c);
                     if (!murk_rgb_finite(L)) {
                         bad++;
                         continue;
@@ -561,6 +566,15 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
         free(tiles);
         return rc;
     }
+    /* Hidden, for bench/stability/atlas.py: MURK_SAMPLE_DUMP=FILE writes every sample's RGB as float32
+     * [pixel][sample][r, g, b] (pixels row by row) after the render, for per-sample statistics (firefly
+     * rate, largest sample, non-finite count). Up to 2^26 samples; not with --resume; under MPI, rank 0's
+     * tiles only. */
+    const char *dump_path = getenv("MURK_SAMPLE_DUMP");
+    if (dump_path && *dump_path && !opts->resume && spp > 0 && npix * (size_t)spp <= ((size_t)1 << 26)) {
+        j.dump = calloc(3 * npix * (size_t)spp, sizeof(float));
+        j.dump_spp = spp;
+    }
 
     int done = 0, rc = 0;
     uint64_t rays_before = 0;
@@ -679,6 +693,14 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     out->max_sample = j.max_sample;
     memcpy(out->media, j.media, sizeof j.media);
     pthread_mutex_destroy(&j.lock);
+    if (j.dump) {
+        FILE *f = fopen(dump_path, "wb");
+        if (!f || fwrite(j.dump, sizeof(float), 3 * npix * (size_t)spp, f) != 3 * npix * (size_t)spp)
+            fprintf(stderr, "murk: MURK_SAMPLE_DUMP: cannot write %s\n", dump_path);
+        if (f)
+            fclose(f);
+        free(j.dump);
+    }
     free(j.sum);
     free(j.count);
     free(tiles);

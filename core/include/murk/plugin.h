@@ -24,7 +24,8 @@
  * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version; 1.2 adds the transmittance
  * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
- * cost counters, murk/counters.h). Anything else — a changed signature,
+ * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
+ * host's sample_light_with / light_pdf_with. Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -178,7 +179,18 @@ typedef struct murk_host {
     /* ABI 1.4: the calling thread's cost counters for the medium whose density field is d
      * (murk/counters.h); never NULL. Call it once per flight, not per collision. */
     murk_counters *(*counters)(const murk_density *d);
+    /* ABI 1.4: sample_light / light_pdf with a strategy (MURK_LIGHT_*). sample_light and light_pdf
+     * are MURK_LIGHT_AREA. */
+    int (*sample_light_with)(const murk_scene *scene, murk_vec3 p, const float u[3], int strategy,
+                             murk_light_sample *ls);
+    float (*light_pdf_with)(const murk_scene *scene, murk_vec3 p, const murk_hit *hit, int strategy);
 } murk_host;
+
+/* Light sampling strategies (ABI 1.4). AREA: a triangle (quads and box faces are two) uniformly by
+ * area, a sphere uniformly in its cone. SOLID_ANGLE: a rectangular quad or box face uniformly in the
+ * solid angle it subtends (spherical rectangles, Urena et al. 2013) where that solid angle is at least
+ * 1e-4 sr (smaller: by area), the rest as AREA. Both choose the light by power. */
+enum { MURK_LIGHT_AREA = 0, MURK_LIGHT_SOLID_ANGLE = 1 };
 
 /* A parameter's value at a hit: the texture if one was given, else the constant. */
 static inline void murk_value_eval(const murk_host *host, const murk_value *v, const murk_hit *hit, float out[3])
