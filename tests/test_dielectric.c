@@ -14,7 +14,10 @@
  *                tables' error with the multiple-scattering compensation, <= 1 + 4 sigma without it;
  *                sample()'s f, pdf agree with eval(), pdf().
  *   check_transmission  `murk check` passes the dielectric and fails broken transmitting fixtures.
- * chi2 and reciprocity run with the compensation on (the default).
+ * chi2 and reciprocity run with the compensation on (the default); with energy from both sides they test
+ * the compensation's split between reflection and transmission (dielectric.c, ms_prepare): a split that
+ * conserves energy on each side but breaks t_o A_o = eta^2 t_i A_i fails reciprocity, and one that is
+ * reciprocal but wrong in size fails energy.
  * Angles are polar angles of wo from the normal; "inside" means wo.z < 0. */
 #include <math.h>
 #include <stdio.h>

@@ -211,6 +211,13 @@ typedef struct ms_at {
     float kr, kt;    /* f = kr (1 - E_o)(1 - E_i) (reflection), kt (1 - E_o)(1 - E_i) [/ eta^2 from outside] */
 } ms_at;
 
+/* 1 - E(mu) on side `side` at m's roughness */
+static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
+{
+    float e0 = ms_row(t, side, m->j, mu), e1 = ms_row(t, side, m->j + 1, mu);
+    return clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
+}
+
 /* The lobe (Kulla & Conty 2017's dielectric extension). Sides: o outside (index 1), i inside (index
  * eta); E_o, E_i the single-scattering energy albedos seen from each side (tables), A_s = 1 - Eavg_s their
  * averages' shortfalls, Favg = integral of F(mu, eta) 2 mu dmu from outside. For wo on side s, wi on s':
@@ -236,26 +243,18 @@ static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float m
     int j = (int)r;
     m->j = j > DI_TAB_NR - 2 ? DI_TAB_NR - 2 : j;
     m->fr = r - (float)m->j;
-    float e0 = ms_row(t, side, m->j, mu_o), e1 = ms_row(t, side, m->j + 1, mu_o);
-    m->one_eo = clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
+    m->one_eo = ms_one_e(t, m, side, mu_o);
     float ao = 1.0f - (t->avg[0][m->j] + (t->avg[0][m->j + 1] - t->avg[0][m->j]) * m->fr);
     float ai = 1.0f - (t->avg[1][m->j] + (t->avg[1][m->j + 1] - t->avg[1][m->j]) * m->fr);
     float as = side ? ai : ao, sum = ao + ai, tf = 1.0f - t->favg;
-    if (!(sum > 1e-7f) || !(as > 1e-7f)) { /* (numerically) no loss to compensate */
+    if (!(sum > 1e-7f)) { /* (numerically) no loss to compensate on either side */
         m->one_eo = m->r = m->kr = m->kt = 0.0f;
         return;
     }
     float ts = side ? tf * ao / (eta * eta * sum) : tf * ai / sum;
     m->r = clamp01(1.0f - ts);
-    m->kr = m->r / (MURK_PI * as);
+    m->kr = as > 1e-7f ? m->r / (MURK_PI * as) : 0.0f; /* kt alone keeps transmission reciprocal */
     m->kt = tf / (MURK_PI * sum);
-}
-
-/* 1 - E(mu) on side `side` at m's roughness */
-static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
-{
-    float e0 = ms_row(t, side, m->j, mu), e1 = ms_row(t, side, m->j + 1, mu);
-    return clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
 }
 
 /* Rough lobes for one index eta: f (without tint) into *f, pdf into *pdf; ms (may be NULL): the
@@ -530,5 +529,6 @@ static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, di_create, di_destroy, di_eval, di_pdf, di_sample,
 };
 
-MURK_MATERIAL_PLUGIN("dielectric", "smooth or rough (GGX) dielectric: reflection, refraction, TIR; RGB dispersion",
+MURK_MATERIAL_PLUGIN("dielectric",
+                     "smooth or rough (GGX, energy-compensated) dielectric: reflection, refraction, TIR; RGB dispersion",
                      params, P_COUNT, &vt)
