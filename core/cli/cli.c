@@ -1,8 +1,10 @@
 /* cli.c — the murk command line:
  *   murk render SCENE.yaml [-o out.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S]
+ *   murk info SCENE.yaml [--set KEY.PATH=VALUE ...]   (info.c)
  *   murk plugins [NAME]
  *   murk compare A.exr B.exr [--diff d.png]
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
+ *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
 #include "check.h"
@@ -30,11 +32,96 @@ static const char usage_text[] =
     "usage:\n"
     "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
     "              [--checkpoint FILE [--every S]] [--resume FILE]\n"
+    "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
     "  murk plugins [NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
+    "  murk help [COMMAND]      (or murk COMMAND --help)\n"
     "  murk --version\n";
+
+/* `murk help COMMAND` and `murk COMMAND --help`: what each subcommand does and takes. */
+static const struct command_help {
+    const char *name, *text;
+} command_help[] = {
+    {"render",
+     "usage: murk render SCENE.yaml [options]\n"
+     "Renders SCENE.yaml to a linear float EXR and an sRGB PNG preview beside it.\n"
+     "  -o, --output OUT.exr   the image (default: the scene's name in the current folder)\n"
+     "  --spp N                samples per pixel (default: the scene's render.spp; with --time, a cap)\n"
+     "  --threads N            worker threads (default: every core); the image does not depend on it\n"
+     "  --set KEY.PATH=VALUE   overrides a scene key (VALUE is YAML; list items by index: shapes.0.radius=0.3);\n"
+     "                         repeatable. A --set of a plugin's type (media.X.type, materials.X.type,\n"
+     "                         integrator.type, media.X.transmittance.type) drops the file's keys of the\n"
+     "                         previous plugin that the new one does not take. A medium or material that\n"
+     "                         nothing uses is an error, so a misspelt name cannot add one silently.\n"
+     "  --time S               renders whole passes until the next would not fit in S seconds\n"
+     "  --checkpoint FILE      saves the render state every --every S seconds (default 60) and at the end\n"
+     "  --resume FILE          continues a checkpoint (of the same scene, seed, size and --set)\n"
+     "  -q, --quiet            no progress bar, no summary line, no notes\n"
+     "Errors are one line, FILE:LINE:COL: what is wrong (or --set KEY.PATH=VALUE: what is wrong), exit 1.\n"},
+    {"info",
+     "usage: murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
+     "Loads SCENE.yaml (with the overrides, checked as murk render checks them) and lists the render settings,\n"
+     "the camera, the integrator, each medium (tracker, transmittance estimator, density grid, majorant grid),\n"
+     "the materials, the shapes (with their material, interior and exterior) and the plugins each uses with the\n"
+     "file each was loaded from. Renders nothing.\n"},
+    {"plugins",
+     "usage: murk plugins [NAME]\n"
+     "Without NAME: lists every plugin on the search path ($MURK_PLUGIN_PATH, then the build's or the installed\n"
+     "plugin folder) with its kind, description and file. With NAME: that plugin's parameters, their types,\n"
+     "defaults and ranges (for a tracker also the keys every medium has).\n"},
+    {"compare",
+     "usage: murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+     "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) and the mean absolute relative error of TEST against\n"
+     "REFERENCE; --diff writes a heat map of |a-b| (white = the 99th percentile).\n"},
+    {"check",
+     "usage: murk check [--seed S] [--quick] PLUGIN...\n"
+     "Runs murk's statistical tests on plugins (by name or .so path): chi-square, reciprocity and furnace for\n"
+     "materials; closed-form transmittance and cross-tracker agreement for trackers; a furnace for integrators.\n"
+     "  --seed S   the random seed (default fixed)\n"
+     "  --quick    fewer samples\n"},
+    {"grid",
+     "usage: murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O]\n"
+     "                 [--coverage C]\n"
+     "Bakes the procedural cloud into a Mitsuba .vol density grid of N^3 voxels over the box [min, max]\n"
+     "(default [-0.5,-0.5,-0.5]-[0.5,0.5,0.5], N 64, seed 1, frequency 3, octaves 5, coverage 0.5).\n"},
+    {"help",
+     "usage: murk help [COMMAND]\n"
+     "Prints the usage of murk, or of one command (the same as murk COMMAND --help).\n"},
+};
+
+/* Prints a command's help on stdout; 0, or 2 (with the usage on stderr) for an unknown command. */
+static int usage(const char *msg);
+static int command_usage(const char *cmd)
+{
+    for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
+        if (!strcmp(command_help[i].name, cmd)) {
+            fputs(command_help[i].text, stdout);
+            return 0;
+        }
+    fprintf(stderr, "murk: no command '%s'\n", cmd);
+    return usage(NULL);
+}
+
+/* 1 if an argument asks for help: -h or --help (not one that follows an option taking a value, such as
+ * `-o -h`, which that option reads). */
+static int wants_help(int argc, char **argv)
+{
+    static const char *const takes_value[] = {"-o", "--output", "--spp", "--threads", "--time", "--checkpoint",
+                                              "--resume", "--every", "--set", "--diff", "--min", "--max", "--res",
+                                              "--seed", "--frequency", "--octaves", "--coverage"};
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h"))
+            return 1;
+        for (size_t k = 0; k < sizeof takes_value / sizeof takes_value[0]; k++)
+            if (!strcmp(argv[i], takes_value[k])) {
+                i++;
+                break;
+            }
+    }
+    return 0;
+}
 
 /* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
  * eight rotating buffers, so one message may quote several. */
@@ -222,9 +309,8 @@ static int cmd_render(int argc, char **argv)
     }
     murk_set_quiet(quiet);
     char err[2048];
-    murk_scene *s = murk_scene_load(scene_path, sets, nsets, err, sizeof err);
+    murk_scene *s = murk_cli_load(scene_path, sets, nsets);
     if (!s) {
-        fprintf(stderr, "%s\n", err);
         free(outbuf);
         free(sets);
         return 1;
@@ -374,9 +460,11 @@ static int cmd_plugins(int argc, char **argv)
     murk_registry_init(&reg);
     char err[1024];
     int rc = 0;
-    if (argc > 1) {
+    if (argc > 1 || (argc == 1 && argv[0][0] == '-')) {
         murk_registry_free(&reg);
-        return usage("plugins takes at most one name");
+        if (argc == 1)
+            fprintf(stderr, "murk: unknown plugins option '%s'\n", q(argv[0]));
+        return usage(argc > 1 ? "plugins takes at most one name" : NULL);
     }
     if (argc == 1) {
         const murk_plugin *p = murk_registry_load(&reg, 0, argv[0], err, sizeof err);
@@ -448,6 +536,9 @@ static int cmd_compare(int argc, char **argv)
             if (i + 1 >= argc)
                 return usage("--diff needs a .png file name");
             diff = argv[++i];
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            fprintf(stderr, "murk: unknown compare option '%s'\n", q(argv[i]));
+            return usage(NULL);
         } else if (!a) {
             a = argv[i];
         } else if (!b) {
@@ -650,8 +741,27 @@ int murk_cli_main(int argc, char **argv)
     if (argc < 2)
         return usage(NULL);
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version")) {
+        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        return 0;
+    }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
+        fputs(usage_text, stdout);
+        return 0;
+    }
+    if (!strcmp(cmd, "help") && argc == 3)
+        return command_usage(!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h") ? "help" : argv[2]);
+    if (!strcmp(cmd, "help"))
+        return usage("help takes at most one command");
+    int known = 0;
+    for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
+        known |= !strcmp(command_help[i].name, cmd);
+    if (known && wants_help(argc - 2, argv + 2))
+        return command_usage(cmd);
     if (!strcmp(cmd, "render"))
         return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "info"))
+        return murk_cli_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "plugins"))
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
@@ -660,14 +770,6 @@ int murk_cli_main(int argc, char **argv)
         return murk_check_main(argc - 1, argv + 1);
     if (!strcmp(cmd, "grid"))
         return cmd_grid(argc - 2, argv + 2);
-    if (!strcmp(cmd, "--version")) {
-        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
-        return 0;
-    }
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(usage_text, stdout);
-        return 0;
-    }
-    fprintf(stderr, "murk: unknown command '%s'\n", cmd);
+    fprintf(stderr, "murk: unknown command '%s'\n", q(cmd));
     return usage(NULL);
 }

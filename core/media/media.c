@@ -38,6 +38,14 @@ struct murk_density {
     float factor;
 };
 
+MURK_API void murk_density_parts(const murk_density *d, const murk_field **field, const murk_bound_grid **grid,
+                                 float *factor)
+{
+    *field = d->field;
+    *grid = &d->grid;
+    *factor = d->factor;
+}
+
 typedef struct walk {
     murk_dda dda;
     float factor;
