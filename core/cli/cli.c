@@ -749,15 +749,13 @@ int murk_cli_main(int argc, char **argv)
         fputs(usage_text, stdout);
         return 0;
     }
-    if (!strcmp(cmd, "help") && argc == 3)
-        return command_usage(!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h") ? "help" : argv[2]);
-    if (!strcmp(cmd, "help"))
-        return usage("help takes at most one command");
     int known = 0;
     for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
         known |= !strcmp(command_help[i].name, cmd);
     if (known && wants_help(argc - 2, argv + 2))
         return command_usage(cmd);
+    if (!strcmp(cmd, "help"))
+        return argc == 3 ? command_usage(argv[2]) : usage("help takes at most one command");
     if (!strcmp(cmd, "render"))
         return cmd_render(argc - 2, argv + 2);
     if (!strcmp(cmd, "info"))
