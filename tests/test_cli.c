@@ -5,64 +5,9 @@
  * with --set applied and checked as `murk render` checks it. */
 #include "testutil.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-/* Reads a whole file into a malloc'd string. */
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    size_t n = 0, cap = 4096;
-    char *buf = malloc(cap);
-    if (f) {
-        size_t r;
-        while ((r = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-            n += r;
-            if (cap - n < 2)
-                buf = realloc(buf, cap *= 2);
-        }
-        fclose(f);
-    }
-    buf[n] = 0;
-    return buf;
-}
-
-/* Runs murk with the NULL-terminated arguments, stdout and stderr captured apart. Returns the exit
- * status (128 + N for signal N). */
-static int run_split(char **out, char **err, const char *const *args)
-{
-    const char *argv[32];
-    int argc = 0;
-    const char *exe = getenv("MURK_EXE");
-    argv[argc++] = exe ? exe : "build/core/murk";
-    for (; *args && argc < 31; args++)
-        argv[argc++] = *args;
-    argv[argc] = NULL;
-    char po[1024], pe[1024];
-    snprintf(po, sizeof po, "%s/cli-out.log", tmp_dir());
-    snprintf(pe, sizeof pe, "%s/cli-err.log", tmp_dir());
-    pid_t pid = fork();
-    if (pid == 0) {
-        int fo = open(po, O_WRONLY | O_CREAT | O_TRUNC, 0644), fe = open(pe, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fo < 0 || fe < 0)
-            _exit(127);
-        dup2(fo, 1);
-        dup2(fe, 2);
-        execv(argv[0], (char *const *)argv);
-        _exit(127);
-    }
-    int status = 0;
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    *out = slurp(po);
-    *err = slurp(pe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
 
 static const char *const commands[] = {"render", "info", "plugins", "compare", "check", "grid", "help"};
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
@@ -83,7 +28,7 @@ static void test_help_everywhere(void **state)
     /* the whole usage: every command named in it */
     static const char *const whole[][2] = {{"--help", NULL}, {"-h", NULL}, {"help", NULL}};
     for (size_t k = 0; k < 3; k++) {
-        int st = run_split(&out, &err, whole[k]);
+        int st = run_murk_split(&out, &err, whole[k]);
         if (st != 0 || err[0])
             fail_msg("[murk %s] exit %d, stderr:\n%s", whole[k][0], st, err);
         for (size_t i = 0; i < NCOMMANDS; i++) {
@@ -101,7 +46,7 @@ static void test_help_everywhere(void **state)
         for (size_t f = 0; f < 4; f++) {
             char what[96];
             snprintf(what, sizeof what, "murk %s %s%s", forms[f][0], forms[f][1], forms[f][2] ? " --help" : "");
-            int st = run_split(&out, &err, forms[f]);
+            int st = run_murk_split(&out, &err, forms[f]);
             expect_help(what, st, out, err, commands[i]);
             free(out);
             free(err);
@@ -109,7 +54,7 @@ static void test_help_everywhere(void **state)
     }
     /* what render's help says about the A/B rules */
     const char *const rh[] = {"render", "--help", NULL};
-    run_split(&out, &err, rh);
+    run_murk_split(&out, &err, rh);
     assert_contains(out, "--set KEY.PATH=VALUE");
     assert_contains(out, "drops the file's keys");
     assert_contains(out, "nothing uses is an error");
@@ -117,7 +62,7 @@ static void test_help_everywhere(void **state)
     free(err);
     /* an option's value that happens to read -h is that option's, not a request for help */
     const char *const val[] = {"render", "x.yaml", "-o", "-h", NULL};
-    assert_int_equal(run_split(&out, &err, val), 2);
+    assert_int_equal(run_murk_split(&out, &err, val), 2);
     assert_contains(err, "the output file must end in .exr, got '-h'");
     free(out);
     free(err);
@@ -134,7 +79,7 @@ static void test_unknown_options(void **state)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char *out, *err;
-        int st = run_split(&out, &err, cases[i]);
+        int st = run_murk_split(&out, &err, cases[i]);
         if (st != 2 || out[0])
             fail_msg("[murk %s %s] exit %d (want 2), stdout:\n%s\nstderr:\n%s", cases[i][0],
                      cases[i][1] ? cases[i][1] : "", st, out, err);
@@ -152,7 +97,7 @@ static void test_info(void **state)
     snprintf(smoke, sizeof smoke, "%s", src_path("scenes/cornell_smoke.yaml"));
     const char *const a[] = {"info", smoke, "--set", "media.smoke.type=decomposition", "--set",
                              "media.smoke.transmittance=ratio", "--set", "media.smoke.majorant_factor=2", NULL};
-    int st = run_split(&out, &err, a);
+    int st = run_murk_split(&out, &err, a);
     if (st != 0)
         fail_msg("murk info failed (%d):\n%s", st, err);
     static const char *const want[] = {
@@ -191,7 +136,7 @@ static void test_info(void **state)
                                            "  - { type: sphere, center: [0, 0, 0], radius: 1, material: m, "
                                            "interior: ink, exterior: air }\n");
     const char *const b[] = {"info", p, NULL};
-    st = run_split(&out, &err, b);
+    st = run_murk_split(&out, &err, b);
     if (st != 0)
         fail_msg("murk info failed (%d):\n%s", st, err);
     assert_contains(out, "starts in air");
@@ -204,7 +149,7 @@ static void test_info(void **state)
 
     /* the same errors as murk render, nothing on stdout */
     const char *const c[] = {"info", smoke, "--set", "media.smok.type=spectral", NULL};
-    assert_int_equal(run_split(&out, &err, c), 1);
+    assert_int_equal(run_murk_split(&out, &err, c), 1);
     assert_string_equal(out, "");
     assert_string_equal(err, "--set media.smok.type=spectral: media.smok is not used by any shape or by the camera; "
                              "did you mean media.smoke?\n");

@@ -37,6 +37,8 @@ const char *write_tmp(const char *name, const char *text);
 
 /* The same with the arguments in a NULL-terminated array. */
 int run_murk_argv(char **out, const char *const *args);
+/* The same with stdout into *out and stderr into *err apart (both malloc'd). */
+int run_murk_split(char **out, char **err, const char *const *args);
 
 /* A scene rendered with several seeds: per pixel and channel (r, g, b, and their average in channel
  * 3) the mean over the renders and the variance of that mean (sample variance over the seeds / n). */
