@@ -115,7 +115,7 @@ static void bench_bad_vary(void **state)
     assert_contains(out, "nothing was rendered");
     free(out);
     assert_int_equal(run_murk(&out, "bench", scene, "--vary", "media.smoke.majorant_factor=1,-2", "-o", dir, NULL), 1);
-    assert_contains(out, "--set:1:29: medium 'smoke' (delta): parameter 'majorant_factor' must be in");
+    assert_contains(out, "--set media.smoke.majorant_factor=-2: medium 'smoke' (delta): parameter 'majorant_factor' must be in");
     assert_contains(out, "in --vary media.smoke.majorant_factor=1,-2 (value '-2')");
     free(out);
     struct stat sb;

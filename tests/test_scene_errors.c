@@ -1,6 +1,6 @@
 /* test_scene_errors.c — bad scenes through `murk render SCENE -o OUT.exr --spp 1`: each must exit with
  * status 1 (never a signal), print exactly one line starting with the exact "file:LINE:COL: " of the
- * fault (or "--set:1:COL: " for a bad override), say what is wrong, and leave no out.exr, out.png or
+ * fault (or "--set KEY.PATH=VALUE: " quoting the override that caused it), say what is wrong, and leave no out.exr, out.png or
  * temporary file behind. The corpus is tests/fixtures/scenes/ plus scenes written here. Then a fuzz-ish
  * pass runs the loader in-process over every 37th truncation / byte mutation of scenes/cornell.yaml
  * and over odd --set strings: it must load or fail with a located message, never crash. */
@@ -14,14 +14,15 @@
 #include <unistd.h>
 
 #include "murk/murk.h"
+#include "util.h"
 
 typedef struct bad_scene {
     const char *name;
     const char *file; /* under tests/fixtures/scenes/, or NULL: `text` written to the temp folder */
     const char *text;
     const char *set;  /* a --set argument (the scene is then scenes/cornell.yaml unless file/text say) */
-    int line, col;    /* expected location; in the --set argument when set_loc */
-    int set_loc;
+    int line, col;    /* expected location (unused when set_loc) */
+    int set_loc;      /* the message starts "--set SET: " */
     const char *msg;  /* substring of the message */
 } bad_scene;
 
@@ -61,16 +62,17 @@ static const bad_scene corpus[] = {
     {"200 nested lists", "deep_nesting.yaml", NULL, NULL, 3, 76, 0, "nesting deeper than 64 levels"},
     {"1e400", "huge_number.yaml", NULL, NULL, 6, 48, 0, "sphere.radius is too large, got '1e400'"},
 
-    /* --set errors (on scenes/cornell.yaml); the column is in the whole KEY.PATH=VALUE argument */
+    /* --set errors (on scenes/cornell.yaml): the message quotes the --set */
     {"--set bad value type", NULL, NULL, "render.spp=abc", 1, 12, 1, "render.spp must be a number, got 'abc'"},
     {"--set index out of range", NULL, NULL, "shapes.12.material=red", 1, 8, 1,
-     "'12' is not an index of this list (it has 8 items)"},
-    {"--set non-numeric index", NULL, NULL, "shapes.x.material=red", 1, 8, 1, "'x' is not an index of this list"},
+     "'12' is not an index of the list shapes (it has 8 items)"},
+    {"--set non-numeric index", NULL, NULL, "shapes.x.material=red", 1, 8, 1, "'x' is not an index of the list shapes"},
     {"--set path through a scalar", NULL, NULL, "camera.fov.x=3", 1, 12, 1, "cannot descend into a scalar at 'x'"},
-    {"--set no key", NULL, NULL, "=3", 1, 1, 1, "expected KEY.PATH=VALUE, got '=3'"},
-    {"--set no value", NULL, NULL, "render.spp", 1, 1, 1, "expected KEY.PATH=VALUE, got 'render.spp'"},
+    {"--set no key", NULL, NULL, "=3", 1, 1, 1, "expected KEY.PATH=VALUE"},
+    {"--set no value", NULL, NULL, "render.spp", 1, 1, 1, "expected KEY.PATH=VALUE"},
     {"--set empty path segment", NULL, NULL, "render..spp=3", 1, 8, 1, "empty key in 'render..spp'"},
-    {"--set malformed YAML value", NULL, NULL, "render.spp=[1", 1, 12, 1, "did not find expected ',' or ']'"},
+    {"--set malformed YAML value", NULL, NULL, "render.spp=[1", 1, 12, 1,
+     "the value after '=' is not valid YAML: did not find expected ',' or ']'"},
     {"--set out of range", NULL, NULL, "materials.white.albedo=2", 1, 24, 1,
      "material 'white' (diffuse): parameter 'albedo' must be in [0, 1], got 2"},
     {"--set undefined material", NULL, NULL, "shapes.0.material=whte", 1, 19, 1,
@@ -168,7 +170,10 @@ static void check_bad(const char *name, const char *scene, const char *set, cons
     if (st != 1)
         fail_msg("[%s] exit status %d (want 1; 128+N is signal N):\n%s", name, st, out);
     char prefix[1200];
-    snprintf(prefix, sizeof prefix, "%s:%d:%d: ", loc_file, line, col);
+    if (set && !strcmp(loc_file, "--set"))
+        snprintf(prefix, sizeof prefix, "--set %s: ", set);
+    else
+        snprintf(prefix, sizeof prefix, "%s:%d:%d: ", loc_file, line, col);
     if (strncmp(out, prefix, strlen(prefix)) != 0)
         fail_msg("[%s] expected the message to start with\n  %s\ngot\n  %s", name, prefix, out);
     if (!strstr(out, msg))
@@ -284,8 +289,8 @@ static void test_generated(void **state)
     rmdir(outdir);
 }
 
-/* An error about a key that a --set added to a map of the scene file is located in the --set
- * argument, not in the scene file. */
+/* An error about a key that a --set added to a map of the scene file quotes the --set, not the scene
+ * file. */
 static void test_set_new_key_location(void **state)
 {
     (void)state;
@@ -296,6 +301,142 @@ static void test_set_new_key_location(void **state)
               "unknown key 'spq' in render (did you mean 'spp'?)");
     check_bad("--set parameter typo", cornell, "materials.white.albdo=0.5", "--set", 1, 17,
               "unknown parameter 'albdo' for material 'white' (diffuse) (did you mean 'albedo'?)");
+}
+
+/* ---- A/B safety: --set typos, tracker swaps, quoted --set errors -------------------------------- */
+
+/* A small scene whose medium `m` is written for decomposition tracking (its own key `control`), with a
+ * transmittance estimator of its own keys, a GGX material with `roughness`, and a spare medium or
+ * material when `extra` says so. */
+static const char *ab_scene(const char *name, const char *extra)
+{
+    static char text[2048];
+    snprintf(text, sizeof text,
+             "murk: 1\n"
+             "render: { resolution: [8, 8], spp: 1 }\n"
+             "camera: { from: [0, 0, 3], at: [0, 0, 0] }\n"
+             "integrator: { type: volpath_nee, max_depth: 4 }\n"
+             "materials:\n"
+             "  shiny: { type: ggx, roughness: 0.3 }\n"
+             "  lamp: { type: diffuse, albedo: 0 }\n"
+             "media:\n"
+             "  m:\n"
+             "    type: decomposition\n"
+             "    control: 0.5\n"
+             "    density: { constant: 1 }\n"
+             "    sigma_s: 0.5\n"
+             "    transmittance: { type: unbiased_raymarch, depth_step: 0.5 }\n"
+             "%s"
+             "shapes:\n"
+             "  - { type: sphere, center: [0, 0, 0], radius: 0.5, material: shiny }\n"
+             "  - { type: box, min: [-1, -1, -1], max: [1, 1, 1], interior: m }\n"
+             "  - { type: quad, center: [0, 2, 0], u: [0.5, 0, 0], v: [0, 0, 0.5], material: lamp, emission: 5 }\n",
+             extra ? extra : "");
+    return write_tmp(name, text);
+}
+
+/* Errors a --set causes, on a scene of scenes/: each message starts "--set SET: ". */
+static const struct { const char *name, *scene, *set, *msg; } set_corpus[] = {
+    /* a misspelt medium or material name is refused with the name it was meant to be */
+    {"--set typo in a medium's name", "cornell_smoke", "media.smok.type=spectral",
+     "media.smok is not used by any shape or by the camera; did you mean media.smoke?"},
+    {"--set typo in a material's name", "cornell", "materials.whte.type=ggx",
+     "materials.whte is not used by any shape; did you mean materials.white?"},
+    /* named as the typo it is before what else is wrong with the block (no type) */
+    {"--set typo before any other error", "cornell_smoke", "media.smok.sigma_s=3",
+     "media.smok is not used by any shape or by the camera; did you mean media.smoke?"},
+    /* whatever reports the error: a reader, the plugin loader, a file the value names, a texture */
+    {"--set medium key not a number", "cornell_smoke", "media.smoke.sigma_a=abc",
+     "medium 'smoke' (delta): parameter 'sigma_a' must be a number, got 'abc'"},
+    {"--set unknown tracker", "cornell_smoke", "media.smoke.type=dleta", "medium 'smoke': no medium plugin 'dleta'"},
+    {"--set missing grid file", "cornell_smoke", "media.smoke.density={grid: nope.vol}", "density grid:"},
+    {"--set texture error", "cornell", "materials.white.albedo={texture: marble}",
+     "material 'white' (diffuse): parameter 'albedo': unknown texture 'marble'"},
+    {"--set tracker key out of range", "cornell_smoke", "media.smoke.g=2",
+     "medium 'smoke' (delta): parameter 'g' must be in [-0.99, 0.99], got 2"},
+};
+
+static void test_set_errors_are_quoted(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof set_corpus / sizeof set_corpus[0]; i++) {
+        char scene[1024];
+        snprintf(scene, sizeof scene, "%s", src_path("scenes/"));
+        strncat(scene, set_corpus[i].scene, sizeof scene - strlen(scene) - 6);
+        strcat(scene, ".yaml");
+        check_bad(set_corpus[i].name, scene, set_corpus[i].set, "--set", 0, 0, set_corpus[i].msg);
+    }
+}
+
+/* A medium or material the scene file defines and nothing uses is refused by murk render and murk
+ * info, located at its name; murk_scene_load leaves it to the command. */
+static void test_unused_is_refused(void **state)
+{
+    (void)state;
+    /* the scene file's own: located at the name */
+    const char *p = ab_scene("unused_medium.yaml", "  fog: { type: delta }\n");
+    check_bad("unused medium in the file", p, NULL, p, 15, 3,
+              "media.fog is not used by any shape or by the camera; reference it (a shape's interior or exterior, "
+              "camera.medium) or remove it");
+    char *out = NULL;
+    assert_int_equal(run_murk(&out, "info", p, NULL), 1);
+    assert_contains(out, "media.fog is not used");
+    free(out);
+    /* referenced by a --set instead: fine */
+    assert_int_equal(run_murk(&out, "info", p, "--set", "camera.medium=fog", NULL), 0);
+    free(out);
+    /* the embedding API loads the file's unused blocks (embedders call trackers directly) ... */
+    char err[2048];
+    murk_scene *s = murk_scene_load(p, NULL, 0, err, sizeof err);
+    if (!s)
+        fail_msg("%s", err);
+    murk_scene_free(s);
+    /* ... but not one a --set made */
+    const char *typo = "media.mm.type=delta";
+    assert_null(murk_scene_load(p, &typo, 1, err, sizeof err));
+    assert_contains(err, "--set media.mm.type=delta: media.mm is not used by any shape or by the camera; did you mean "
+                         "media.m?");
+}
+
+/* A --set of a plugin's type drops the file's keys of the previous plugin that the new one does not
+ * take: a tracker (decomposition's control), an estimator (unbiased_raymarch's depth_step), a material
+ * (ggx's roughness). Keys the old plugin did not take either, or that a --set gave, stay errors. */
+static void test_type_swap(void **state)
+{
+    (void)state;
+    const char *p = ab_scene("swap.yaml", NULL);
+    char exr[1200], *out = NULL;
+    snprintf(exr, sizeof exr, "%s/swap.exr", tmp_dir());
+    int st = run_murk(&out, "render", p, "-o", exr, "--set", "media.m.type=delta", "--set",
+                      "media.m.transmittance.type=ratio", "--set", "materials.shiny.type=diffuse", NULL);
+    if (st != 0)
+        fail_msg("swapping the tracker, the estimator and the material failed (%d):\n%s", st, out);
+    assert_contains(out, "medium 'm' (delta): dropped 'control'");
+    assert_contains(out, "a parameter of 'decomposition' that the --set of its type replaced");
+    assert_contains(out, "dropped 'depth_step'");
+    assert_contains(out, "dropped 'roughness'");
+    assert_int_equal(access(exr, R_OK), 0);
+    free(out);
+    /* murk info shows the new plugins */
+    assert_int_equal(run_murk(&out, "info", p, "--set", "media.m.type=delta", NULL), 0);
+    assert_contains(out, "tracker        delta");
+    assert_not_contains(out, "decomposition.so");
+    free(out);
+    /* without the swap, the same keys under delta are refused: the drop is what makes it work */
+    const char *q = write_tmp("delta_control.yaml",
+                              "murk: 1\nmedia:\n  m: { type: delta, control: 0.5 }\n"
+                              "shapes: [ { type: box, min: [0, 0, 0], max: [1, 1, 1], interior: m } ]\n");
+    check_bad("control under delta", q, NULL, q, 3, 21, "unknown parameter 'control' for medium 'm' (delta)");
+    /* a key given by a --set is the user's: still refused, quoting that --set */
+    st = run_murk(&out, "render", p, "-o", exr, "--set", "media.m.type=delta", "--set", "media.m.control=0.3", NULL);
+    assert_int_equal(st, 1);
+    assert_contains(out, "--set media.m.control=0.3: unknown parameter 'control' for medium 'm' (delta)");
+    free(out);
+    /* a key of the file that the old tracker did not take either stays the file's error */
+    const char *r = write_tmp("contrl.yaml", "murk: 1\nmedia:\n  m: { type: decomposition, contrl: 0.5 }\n"
+                                             "shapes: [ { type: box, min: [0, 0, 0], max: [1, 1, 1], interior: m } ]\n");
+    check_bad("file typo survives a swap", r, "media.m.type=delta", r, 3, 29,
+              "unknown parameter 'contrl' for medium 'm' (delta)");
 }
 
 /* Encoding errors (libyaml reader errors) are located where the bad byte is, not at 1:1. */
@@ -326,7 +467,7 @@ static char *read_all(const char *path, size_t *n)
 }
 
 /* Loads `path` in-process: either a scene, or an error "PATH:LINE:COL: message" on one line (or
- * "--set:1:COL: ..." when a set is given). Returns 1 if it loaded. */
+ * "--set SET: message" when a set is given). Returns 1 if it loaded. */
 static int load_or_located_error(const char *path, const char *set, const char *what)
 {
     char err[2048];
@@ -338,10 +479,21 @@ static int load_or_located_error(const char *path, const char *set, const char *
     }
     size_t pl = strlen(path);
     const char *rest = NULL;
+    char quoted[512];
+    if (set) { /* the set as the message quotes it: printable */
+        char raw[512];
+        snprintf(raw, sizeof raw, "--set %s: ", set);
+        murk_printable(quoted, sizeof quoted, raw);
+    }
+    if (set && strncmp(err, quoted, strlen(quoted)) == 0) {
+        if (strchr(err, '\n'))
+            fail_msg("[%s] error of more than one line: \"%s\"", what, err);
+        if (!err[strlen(quoted)])
+            fail_msg("[%s] error with no message: \"%s\"", what, err);
+        return 0;
+    }
     if (strncmp(err, path, pl) == 0 && err[pl] == ':')
         rest = err + pl + 1;
-    else if (set && strncmp(err, "--set:", 6) == 0)
-        rest = err + 6;
     int line = 0, col = 0, used = 0;
     if (!rest || sscanf(rest, "%d:%d: %n", &line, &col, &used) != 2 || used == 0 || line < 1 || col < 1)
         fail_msg("[%s] error without a file:line:col prefix: \"%s\"", what, err);
@@ -426,9 +578,10 @@ static void test_odd_sets(void **state)
         snprintf(what, sizeof what, "--set '%s'", sets[i]);
         load_or_located_error(cornell, sets[i], what);
     }
-    /* and a few that must load */
+    /* and a few that must load (murk_scene_load leaves the file's unused materials to the command) */
     assert_int_equal(load_or_located_error(cornell, "shapes=[]", "--set shapes=[]"), 1);
-    assert_int_equal(load_or_located_error(cornell, "materials.new.type=diffuse", "--set new material"), 1);
+    /* a material a --set adds and nothing uses is refused, quoting the --set */
+    assert_int_equal(load_or_located_error(cornell, "materials.new.type=diffuse", "--set new material"), 0);
     assert_int_equal(load_or_located_error(cornell, "shapes.0.type=sphere", "--set quad to sphere"), 0);
 }
 
@@ -440,6 +593,9 @@ int main(void)
         cmocka_unit_test(test_generated),
         cmocka_unit_test(test_set_new_key_location),
         cmocka_unit_test(test_encoding_error_location),
+        cmocka_unit_test(test_unused_is_refused),
+        cmocka_unit_test(test_type_swap),
+        cmocka_unit_test(test_set_errors_are_quoted),
         cmocka_unit_test(test_truncations),
         cmocka_unit_test(test_mutations),
         cmocka_unit_test(test_odd_sets),

@@ -71,7 +71,29 @@ int run_murk(char **out, const char *arg0, ...)
     return run_murk_argv(out, args);
 }
 
-int run_murk_argv(char **out, const char *const *args)
+/* A whole file as a malloc'd string ("" if it cannot be read). */
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    size_t n = 0, cap = 4096;
+    char *buf = malloc(cap);
+    if (f) {
+        size_t r;
+        while ((r = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+            n += r;
+            if (cap - n < 2)
+                buf = realloc(buf, cap *= 2);
+        }
+        fclose(f);
+    }
+    buf[n] = 0;
+    return buf;
+}
+
+static int run_argv_split(char **out, char **err, const char *const *argv);
+
+/* Runs murk with stdout into *out and stderr into *err, or both into *out when err is NULL. */
+static int run_captured(char **out, char **err, const char *const *args)
 {
     const char *argv[96];
     int argc = 0;
@@ -79,47 +101,46 @@ int run_murk_argv(char **out, const char *const *args)
     for (; *args && argc < 95; args++)
         argv[argc++] = *args;
     argv[argc] = NULL;
-    return run_argv(out, argv);
+    return run_argv_split(out, err, argv);
 }
 
-int run_argv(char **out, const char *const *argv)
+int run_argv(char **out, const char *const *argv) { return run_argv_split(out, NULL, argv); }
+
+/* Runs argv (argv[0] a path) with stdout into *out and stderr into *err, or both into *out if err is NULL. */
+static int run_argv_split(char **out, char **err, const char *const *argv)
 {
-    char logpath[512];
+    char logpath[512], errpath[512];
     snprintf(logpath, sizeof logpath, "%s/run-%d.log", tmp_dir(), (int)getpid());
+    snprintf(errpath, sizeof errpath, "%s/run-%d.err", tmp_dir(), (int)getpid());
     pid_t pid = fork();
     if (pid == 0) {
         int fd = open(logpath, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fd < 0)
+        int fe = err ? open(errpath, O_WRONLY | O_CREAT | O_TRUNC, 0644) : fd;
+        if (fd < 0 || fe < 0)
             _exit(127);
         dup2(fd, 1);
-        dup2(fd, 2);
+        dup2(fe, 2);
         close(fd);
+        if (fe != fd)
+            close(fe);
         execv(argv[0], (char *const *)argv);
         _exit(127);
     }
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    if (out) {
-        FILE *f = fopen(logpath, "rb");
-        size_t n = 0, cap = 4096;
-        char *buf = malloc(cap);
-        if (f) {
-            size_t r;
-            while ((r = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-                n += r;
-                if (cap - n < 2)
-                    buf = realloc(buf, cap *= 2);
-            }
-            fclose(f);
-        }
-        buf[n] = 0;
-        *out = buf;
-    }
+    if (out)
+        *out = slurp(logpath);
+    if (err)
+        *err = slurp(errpath);
     if (WIFSIGNALED(status))
         return 128 + WTERMSIG(status);
     return WEXITSTATUS(status);
 }
+
+int run_murk_argv(char **out, const char *const *args) { return run_captured(out, NULL, args); }
+
+int run_murk_split(char **out, char **err, const char *const *args) { return run_captured(out, err, args); }
 
 /* The same chi-square test as `murk check` (core/check/sphere.c). */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out)

@@ -39,6 +39,8 @@ const char *write_tmp(const char *name, const char *text);
 
 /* The same with the arguments in a NULL-terminated array. */
 int run_murk_argv(char **out, const char *const *args);
+/* The same with stdout into *out and stderr into *err apart (both malloc'd). */
+int run_murk_split(char **out, char **err, const char *const *args);
 /* The same for any program: argv[0] is its path (e.g. mpirun's, with murk's among the arguments). */
 int run_argv(char **out, const char *const *argv);
 

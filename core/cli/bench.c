@@ -263,9 +263,16 @@ static int check_vary_key(const murk_scene *s, const vary *v, char *err, size_t 
     return rc;
 }
 
+/* A variant's scene as `murk render` loads it: with the rule that every medium and material is used, so a
+ * misspelt medium in a --vary or --set fails here instead of adding an unused block. */
 static murk_scene *load_with(const bench *b, const char *const *sets, size_t nsets, char *err, size_t errlen)
 {
-    return murk_scene_load(b->scene, sets, nsets, err, errlen);
+    murk_scene *s = murk_scene_load(b->scene, sets, nsets, err, errlen);
+    if (s && murk_scene_check_unused(s, err, errlen)) {
+        murk_scene_free(s);
+        s = NULL;
+    }
+    return s;
 }
 
 /* Every --vary value alone, then every variant, loads: the located loader message and the --vary that

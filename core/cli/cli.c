@@ -1,8 +1,10 @@
 /* cli.c — the murk command line:
  *   murk render SCENE.yaml [-o out.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S]
+ *   murk info SCENE.yaml [--set KEY.PATH=VALUE ...]   (info.c)
  *   murk plugins [NAME]
  *   murk compare A.exr B.exr [--diff d.png]
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
+ *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
 #include "check.h"
@@ -33,12 +35,112 @@ static const char usage_text[] =
     "              [--checkpoint FILE [--every S]] [--resume FILE] [--part I/N]\n"
     "  mpirun -n N murk render ...          (one image over N processes)\n"
     "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
+    "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
     "  murk plugins [NAME]\n"
-    "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
     "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
+    "  murk help [COMMAND]      (or murk COMMAND --help)\n"
     "  murk --version\n";
+
+/* `murk help COMMAND` and `murk COMMAND --help`: what each subcommand does and takes. */
+static const struct command_help {
+    const char *name, *text;
+} command_help[] = {
+    {"render",
+     "usage: murk render SCENE.yaml [options]\n"
+     "Renders SCENE.yaml to a linear float EXR and an sRGB PNG preview beside it.\n"
+     "  -o, --output OUT.exr   the image (default: the scene's name in the current folder)\n"
+     "  --spp N                samples per pixel (default: the scene's render.spp; with --time, a cap)\n"
+     "  --threads N            worker threads (default: every core); the image does not depend on it\n"
+     "  --set KEY.PATH=VALUE   overrides a scene key (VALUE is YAML; list items by index: shapes.0.radius=0.3);\n"
+     "                         repeatable. A --set of a plugin's type (media.X.type, materials.X.type,\n"
+     "                         integrator.type, media.X.transmittance.type) drops the file's keys of the\n"
+     "                         previous plugin that the new one does not take. A medium or material that\n"
+     "                         nothing uses is an error, so a misspelt name cannot add one silently.\n"
+     "  --time S               renders whole passes until the next would not fit in S seconds\n"
+     "  --checkpoint FILE      saves the render state every --every S seconds (default 60) and at the end\n"
+     "  --resume FILE          continues a checkpoint (of the same scene, seed, size and --set)\n"
+     "  --part I/N             renders part I of N (the 16x16 tiles t with t % N == I) for murk merge\n"
+     "  -q, --quiet            no progress bar, no summary line, no notes\n"
+     "Errors are one line, FILE:LINE:COL: what is wrong (or --set KEY.PATH=VALUE: what is wrong), exit 1.\n"},
+    {"info",
+     "usage: murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
+     "Loads SCENE.yaml (with the overrides, checked as murk render checks them) and lists the render settings,\n"
+     "the camera, the integrator, each medium (tracker, transmittance estimator, density grid, majorant grid),\n"
+     "the materials, the shapes (with their material, interior and exterior) and the plugins each uses with the\n"
+     "file each was loaded from. Renders nothing.\n"},
+    {"plugins",
+     "usage: murk plugins [NAME]\n"
+     "Without NAME: lists every plugin on the search path ($MURK_PLUGIN_PATH, then the build's or the installed\n"
+     "plugin folder) with its kind, description and file. With NAME: that plugin's parameters, their types,\n"
+     "defaults and ranges (for a tracker also the keys every medium has).\n"},
+    {"compare",
+     "usage: murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+     "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) with its standard error, the mean absolute relative error,\n"
+     "a bias test (mean of a-b with its standard error and z-score) and, from the EXRs' render times and cost\n"
+     "counters, the efficiency 1/(relMSE x seconds) and 1/(relMSE x density lookups).\n"
+     "  --crop X,Y,W,H   only the pixels of that rectangle\n"
+     "  --json           one JSON object instead of text\n"
+     "  --diff D.png     a heat map of |a-b| (white = the 99th percentile) and D_signed.png, the signed relative\n"
+     "                   difference (a-b)/(|b|+0.01) on a fixed scale: blue -S, white 0, red +S\n"
+     "  --scale S        that scale (default 1)\n"},
+    {"bench", NULL}, /* bench.c prints its own (murk bench --help) */
+    {"merge",
+     "usage: murk merge OUT.exr PART.exr...\n"
+     "Merges the parts of a `murk render --part I/N` render (any order) into OUT.exr and its PNG preview,\n"
+     "bitwise identical to a single-process render. Every part 0..N-1 must be given once, whole, and of the\n"
+     "same render (scene, --set, seed, spp, size, split, murk version, plugins); otherwise the error names it.\n"},
+    {"check",
+     "usage: murk check [--seed S] [--quick] PLUGIN...\n"
+     "Runs murk's statistical tests on plugins (by name or .so path): chi-square, reciprocity and furnace for\n"
+     "materials; closed-form transmittance and cross-tracker agreement for trackers; a furnace for integrators.\n"
+     "  --seed S   the random seed (default fixed)\n"
+     "  --quick    fewer samples\n"},
+    {"grid",
+     "usage: murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O]\n"
+     "                 [--coverage C]\n"
+     "Bakes the procedural cloud into a Mitsuba .vol density grid of N^3 voxels over the box [min, max]\n"
+     "(default [-0.5,-0.5,-0.5]-[0.5,0.5,0.5], N 64, seed 1, frequency 3, octaves 5, coverage 0.5).\n"},
+    {"help",
+     "usage: murk help [COMMAND]\n"
+     "Prints the usage of murk, or of one command (the same as murk COMMAND --help).\n"},
+};
+
+/* Prints a command's help on stdout; 0, or 2 (with the usage on stderr) for an unknown command. */
+static int command_usage(const char *cmd)
+{
+    for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
+        if (!strcmp(command_help[i].name, cmd)) {
+            if (!command_help[i].text)
+                return murk_cli_bench(1, (char *[]){"--help", NULL});
+            fputs(command_help[i].text, stdout);
+            return 0;
+        }
+    fprintf(stderr, "murk: no command '%s'\n", cmd);
+    return murk_cli_usage(NULL);
+}
+
+/* 1 if an argument asks for help: -h or --help (not one that follows an option taking a value, such as
+ * `-o -h`, which that option reads). */
+static int wants_help(int argc, char **argv)
+{
+    static const char *const takes_value[] = {"-o", "--output", "--spp", "--threads", "--time", "--checkpoint",
+                                              "--resume", "--every", "--set", "--diff", "--part",
+                                              "--crop", "--scale", "--min", "--max", "--res",
+                                              "--seed", "--frequency", "--octaves", "--coverage"};
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h"))
+            return 1;
+        for (size_t k = 0; k < sizeof takes_value / sizeof takes_value[0]; k++)
+            if (!strcmp(argv[i], takes_value[k])) {
+                i++;
+                break;
+            }
+    }
+    return 0;
+}
 
 /* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
  * eight rotating buffers, so one message may quote several. */
@@ -359,9 +461,8 @@ static int render_main(int argc, char **argv)
     }
     murk_set_quiet(quiet);
     char err[2048];
-    murk_scene *s = murk_scene_load(scene_path, sets, nsets, err, sizeof err);
+    murk_scene *s = murk_cli_load(scene_path, sets, nsets);
     if (!s) {
-        fprintf(stderr, "%s\n", err);
         free(outbuf);
         free(sets);
         return 1;
@@ -550,9 +651,11 @@ static int cmd_plugins(int argc, char **argv)
     murk_registry_init(&reg);
     char err[1024];
     int rc = 0;
-    if (argc > 1) {
+    if (argc > 1 || (argc == 1 && argv[0][0] == '-')) {
         murk_registry_free(&reg);
-        return usage("plugins takes at most one name");
+        if (argc == 1)
+            fprintf(stderr, "murk: unknown plugins option '%s'\n", q(argv[0]));
+        return usage(argc > 1 ? "plugins takes at most one name" : NULL);
     }
     if (argc == 1) {
         const murk_plugin *p = murk_registry_load(&reg, 0, argv[0], err, sizeof err);
@@ -732,8 +835,25 @@ int murk_cli_main(int argc, char **argv)
     if (argc < 2)
         return usage(NULL);
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version")) {
+        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        return 0;
+    }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
+        fputs(usage_text, stdout);
+        return 0;
+    }
+    int known = 0;
+    for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
+        known |= !strcmp(command_help[i].name, cmd);
+    if (known && wants_help(argc - 2, argv + 2))
+        return command_usage(cmd);
+    if (!strcmp(cmd, "help"))
+        return argc == 3 ? command_usage(argv[2]) : usage("help takes at most one command");
     if (!strcmp(cmd, "render"))
         return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "info"))
+        return murk_cli_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "plugins"))
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
@@ -746,14 +866,6 @@ int murk_cli_main(int argc, char **argv)
         return cmd_grid(argc - 2, argv + 2);
     if (!strcmp(cmd, "merge"))
         return murk_cli_merge(argc - 2, argv + 2);
-    if (!strcmp(cmd, "--version")) {
-        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
-        return 0;
-    }
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(usage_text, stdout);
-        return 0;
-    }
-    fprintf(stderr, "murk: unknown command '%s'\n", cmd);
+    fprintf(stderr, "murk: unknown command '%s'\n", q(cmd));
     return usage(NULL);
 }

@@ -170,7 +170,7 @@ void murk_field_bounds(const murk_field *f, murk_vec3 *lo, murk_vec3 *hi, int *i
 MURK_API float murk_field_max(const murk_field *f) { return f->vmax; }
 float murk_field_min(const murk_field *f) { return f->vmin; }
 
-void murk_field_grid(const murk_field *f, int res[3], const float **data)
+MURK_API void murk_field_grid(const murk_field *f, int res[3], const float **data)
 {
     for (int a = 0; a < 3; a++)
         res[a] = f->res[a];

@@ -40,6 +40,14 @@ struct murk_density {
     unsigned slot; /* its medium's cost counters (host.h) */
 };
 
+MURK_API void murk_density_parts(const murk_density *d, const murk_field **field, const murk_bound_grid **grid,
+                                 float *factor)
+{
+    *field = d->field;
+    *grid = &d->grid;
+    *factor = d->factor;
+}
+
 typedef struct walk {
     murk_dda dda;
     float factor;
@@ -265,6 +273,7 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
                                &nm->data, &p, &nm->m.tr_self, err, errlen))
         return -1;
     nm->m.tr_vt = p->desc->vtable;
+    nm->tr_plugin = p;
     return 0;
 }
 

@@ -21,6 +21,11 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
 extern const char *const murk_medium_special_keys[2];
 void murk_media_free(murk_scene *s);
+/* What a medium's density is made of, for `murk info`: its field, majorant grid and majorant_factor. */
+struct murk_field;
+struct murk_bound_grid;
+void murk_density_parts(const murk_density *d, const struct murk_field **field, const struct murk_bound_grid **grid,
+                        float *factor);
 
 float murk_media_density(const murk_density *d, murk_vec3 p);
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);

@@ -478,6 +478,63 @@ static void scene_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi)
     }
 }
 
+/* ---- Unused media and materials -------------------------------------------------------------- */
+
+/* 1 if `name` is the string value of key `key` in map m. */
+static int names(const murk_ynode *m, const char *key, const char *name)
+{
+    const murk_ynode *v = murk_ymap_get(m, key);
+    return v && v->kind == MURK_Y_SCALAR && strcmp(v->str, name) == 0;
+}
+
+/* Is the medium (media = 1) or material `name` referenced: by a shape's interior/exterior or the
+ * camera's medium; by a shape's material? */
+static int referenced(const murk_ynode *root, int media, const char *name)
+{
+    const murk_ynode *shapes = murk_ymap_get(root, "shapes");
+    if (media && names(murk_ymap_get(root, "camera"), "medium", name))
+        return 1;
+    for (size_t i = 0; shapes && shapes->kind == MURK_Y_SEQ && i < shapes->n; i++) {
+        const murk_ynode *sh = shapes->items[i];
+        if (media ? names(sh, "interior", name) || names(sh, "exterior", name) : names(sh, "material", name))
+            return 1;
+    }
+    return 0;
+}
+
+/* A medium or material that nothing references is an error (usually a typo in a --set's name, which
+ * would otherwise add a block and leave the scene as it was): located at its name, with the closest
+ * other name. only_set: only blocks a --set created (murk_scene_load checks them before anything
+ * loads, so that such a typo is named first); else all (murk_scene_check_unused, once the scene has
+ * loaded, so that a file's other errors come first). */
+static int check_unused(const murk_ynode *root, int only_set, char *err, size_t errlen)
+{
+    for (int media = 1; media >= 0; media--) {
+        const char *block = media ? "media" : "materials";
+        const murk_ynode *b = murk_ymap_get(root, block);
+        if (!b || b->kind != MURK_Y_MAP)
+            continue;
+        for (size_t i = 0; i < b->n; i++) {
+            if ((only_set && !murk_yfrom_set(b->key_file[i])) || referenced(root, media, b->keys[i]))
+                continue;
+            const char *others[256];
+            size_t no = 0;
+            for (size_t j = 0; j < b->n && no < 256; j++)
+                if (j != i)
+                    others[no++] = b->keys[j];
+            const char *sug = murk_did_you_mean(b->keys[i], others, no);
+            const char *by = media ? "by any shape or by the camera" : "by any shape";
+            if (sug)
+                return murk_yerr_key(err, errlen, b, i, "%s.%s is not used %s; did you mean %s.%s?", block, b->keys[i],
+                                     by, block, sug);
+            return murk_yerr_key(err, errlen, b, i, "%s.%s is not used %s; reference it (%s) or remove it", block,
+                                 b->keys[i], by, media ? "a shape's interior or exterior, camera.medium" :
+                                 "a shape's material");
+        }
+    }
+    return 0;
+}
+
 static int load_document(murk_scene *s, char *err, size_t errlen)
 {
     static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
@@ -494,6 +551,8 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     if (ver != 1)
         return ERR(v, "scene format version %lld is not supported (this murk reads version 1)", ver);
+    if (check_unused(root, 1, err, errlen))
+        return -1;
     const murk_ynode *c;
     if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
         return -1;
@@ -516,6 +575,11 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
     murk_vec3 lo, hi;
     scene_bounds(s, &lo, &hi);
     return murk_media_check_depth(s, murk_ymap_get(root, "media"), lo, hi, err, errlen);
+}
+
+MURK_API int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen)
+{
+    return s->doc.root ? check_unused(s->doc.root, 0, err, errlen) : 0;
 }
 
 MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen)

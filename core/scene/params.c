@@ -3,6 +3,7 @@
  * media loader (media.c). */
 #include "params.h"
 #include "host.h"
+#include "media.h"
 #include "scene.h"
 #include "texture.h"
 #include "util.h"
@@ -41,6 +42,47 @@ static int choice_index(const char *choices, const char *word)
     }
 }
 
+/* The length of the "file:line:col: " or "--set KEY=VALUE: " (with its space) that starts a located message err (a
+ * label of the document's), or 0. */
+static size_t location_length(const murk_ydoc *doc, const char *err)
+{
+    for (size_t i = 0; i <= doc->nsets; i++) {
+        const char *f = i < doc->nsets ? doc->sets[i] : doc->file;
+        size_t fl = f ? strlen(f) : 0;
+        if (!fl || strncmp(err, f, fl) != 0 || err[fl] != ':')
+            continue;
+        int used = 0, line, col;
+        size_t at = fl + 1;
+        if (sscanf(err + fl, ":%d:%d:%n", &line, &col, &used) == 2 && used > 0)
+            at = fl + (size_t)used;
+        return at + (err[at] == ' ');
+    }
+    return 0;
+}
+
+/* A key of the file in a block whose `type` a --set swapped (map->swapped_type) that the file's plugin
+ * takes and the new one does not: dropped with a note, so that `--set media.X.type=delta` works on a
+ * block written for decomposition (`control`). A key the old plugin does not take either stays an
+ * error, and so does a key a --set gave. note: say so (once per key: not for the media's core keys'
+ * read, which meets the same key before the tracker's). */
+static int dropped_by_swap(const murk_ynode *map, size_t k, uint32_t kind, const char *who, int note)
+{
+    if (!map->swapped_type || murk_yfrom_set(map->key_file[k]) || murk_yfrom_set(map->items[k]->file))
+        return 0;
+    murk_registry reg;
+    murk_registry_init(&reg);
+    char lerr[1024];
+    const murk_plugin *old = murk_registry_load(&reg, (int)kind, map->swapped_type, lerr, sizeof lerr);
+    int took = 0;
+    for (uint32_t i = 0; old && i < old->desc->nparams && !took; i++)
+        took = strcmp(old->desc->params[i].name, map->keys[k]) == 0;
+    if (took && note)
+        murk_log(MURK_LOG_INFO, "%s: dropped '%s' (%s:%d), a parameter of '%s' that the --set of its type replaced",
+                 who, map->keys[k], map->key_file[k], map->key_line[k], map->swapped_type);
+    murk_registry_free(&reg);
+    return took;
+}
+
 /* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
  * block in messages, e.g. "material 'metal' (ggx)". */
 int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
@@ -66,6 +108,8 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
         for (uint32_t i = 0; i < d->nparams; i++)
             if (strcmp(d->params[i].name, key) == 0)
                 idx = (int)i;
+        if (idx < 0 && dropped_by_swap(map, k, d->kind, who, d->params != murk_medium_core_params))
+            continue;
         if (idx < 0) {
             const char *cand[96];
             size_t nc = 0;
@@ -74,10 +118,14 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
             for (size_t j = 0; j < nskip && nc < 96; j++)
                 cand[nc++] = skip[j];
             const char *sug = murk_did_you_mean(key, cand, nc);
+            char hint[160];
             if (sug)
-                return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (did you mean '%s'?)", key, who, sug);
-            return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (see: murk plugins %s)", key, who,
-                                 d->name);
+                snprintf(hint, sizeof hint, "did you mean '%s'?", sug);
+            else
+                snprintf(hint, sizeof hint, "see: murk plugins %s", d->name);
+            if (murk_yfrom_set(map->items[k]->file) && !murk_yfrom_set(map->key_file[k])) /* a --set's value */
+                return murk_yerr(err, errlen, map->items[k], "unknown parameter '%s' for %s (%s)", key, who, hint);
+            return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (%s)", key, who, hint);
         }
         const murk_param *p = &d->params[idx];
         murk_value *v = &values[idx];
@@ -92,12 +140,10 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
         case MURK_PARAM_RGB:
             if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE)) {
                 murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
-                if (!t) { /* name the parameter after the location: "file:l:c: WHO: message" */
+                if (!t) { /* name the parameter after the location: "LOCATION: WHO: message" */
                     char msg[2048];
-                    const char *rest = err;
-                    for (int colons = 0; colons < 3 && (rest = strchr(rest, ':')); colons++)
-                        rest++;
-                    snprintf(msg, sizeof msg, "%.*s %s:%s", rest ? (int)(rest - err) : 0, err, what, rest ? rest : err);
+                    size_t at = location_length(&s->doc, err);
+                    snprintf(msg, sizeof msg, "%.*s%s: %s", (int)at, err, what, err + at);
                     snprintf(err, errlen, "%s", msg);
                     return -1;
                 }

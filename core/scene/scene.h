@@ -51,6 +51,7 @@ typedef struct murk_named_medium {
     murk_medium m;
     murk_medium_data data;
     const murk_plugin *plugin;
+    const murk_plugin *tr_plugin; /* its transmittance estimator's, or NULL (m.tr_vt may be the counters' wrapper) */
     struct murk_density *density; /* owned */
 } murk_named_medium;
 
@@ -93,6 +94,13 @@ struct murk_scene {
     RTCDevice device;
     RTCScene rtc;
 };
+
+/* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
+ * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the
+ * camera; did you mean media.OTHER?" (or "--set ...: ..." for one a --set made). murk_scene_load itself
+ * refuses only those a --set made (a misspelt name): embedders may load media and materials to call
+ * them directly. Returns 0, or -1 with err. */
+int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
 
 /* Releases what a shape owns (its triangle arrays). */
 void murk_shape_free(murk_shape *sh);

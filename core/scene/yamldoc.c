@@ -36,6 +36,7 @@ void murk_ynode_free(murk_ynode *n)
     free(n->key_col);
     free(n->key_file);
     free(n->str);
+    free(n->swapped_type);
     free(n);
 }
 
@@ -57,7 +58,7 @@ static void append(murk_ynode *parent, murk_ynode *child, char *key, const char 
     parent->n = n;
 }
 
-murk_ynode *murk_ymap_get(const murk_ynode *map, const char *key)
+MURK_API murk_ynode *murk_ymap_get(const murk_ynode *map, const char *key)
 {
     if (!map || map->kind != MURK_Y_MAP)
         return NULL;
@@ -303,18 +304,22 @@ int murk_ydoc_load_file(murk_ydoc *doc, const char *path, char *err, size_t errl
 void murk_ydoc_free(murk_ydoc *doc)
 {
     murk_ynode_free(doc->root);
+    for (size_t i = 0; i < doc->nsets; i++)
+        free(doc->sets[i]);
+    free(doc->sets);
     free(doc->file);
     memset(doc, 0, sizeof *doc);
 }
 
-static void retag(murk_ynode *n, const char *file, int col_offset)
+/* Every node and key of a --set's value: the --set's label as file, line 0 ("LABEL: message"). */
+static void retag(murk_ynode *n, const char *file)
 {
     n->file = file;
-    n->col += col_offset;
+    n->line = n->col = 0;
     for (size_t i = 0; i < n->n; i++) {
-        retag(n->items[i], file, col_offset);
-        if (n->key_col)
-            n->key_col[i] += col_offset;
+        retag(n->items[i], file);
+        if (n->key_line)
+            n->key_line[i] = n->key_col[i] = 0;
         if (n->key_file)
             n->key_file[i] = file;
     }
@@ -330,60 +335,58 @@ static int is_index(const char *s)
     return 1;
 }
 
+int murk_yfrom_set(const char *file) { return file && strncmp(file, "--set ", 6) == 0; }
+
 int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errlen)
 {
-    static const char *const SETFILE = "--set";
+    size_t al = strlen(assignment);
+    char *label = murk_xmalloc(al + 7);
+    memcpy(label, "--set ", 6);
+    memcpy(label + 6, assignment, al + 1);
+    doc->sets = murk_xrealloc(doc->sets, (doc->nsets + 1) * sizeof *doc->sets);
+    doc->sets[doc->nsets++] = label; /* owned by the document: its nodes name it */
     const char *eq = strchr(assignment, '=');
-    if (!eq || eq == assignment) {
-        murk_err_at(err, errlen, SETFILE, 1, 1, "expected KEY.PATH=VALUE, got '%s'", assignment);
-        return -1;
-    }
-    int value_col = (int)(eq - assignment) + 2;
+    if (!eq || eq == assignment)
+        return murk_err_file(err, errlen, label, "expected KEY.PATH=VALUE");
     murk_ydoc vdoc;
     char verrbuf[512];
-    if (murk_ydoc_load_string(&vdoc, eq + 1, SETFILE, verrbuf, sizeof verrbuf) != 0) {
-        /* shift the column to the position inside the whole argument */
-        int l = 1, c = 1;
-        if (sscanf(verrbuf, "--set:%d:%d:", &l, &c) == 2) {
-            const char *msg = strchr(strchr(strchr(verrbuf, ':') + 1, ':') + 1, ':') + 1;
-            murk_err_at(err, errlen, SETFILE, 1, c + value_col - 1, "%s", msg + (*msg == ' '));
-        } else {
-            snprintf(err, errlen, "%s", verrbuf);
-        }
-        return -1;
+    if (murk_ydoc_load_string(&vdoc, eq + 1, "VALUE", verrbuf, sizeof verrbuf) != 0) {
+        /* "VALUE:L:C: message": the message only (the value is short, and quoted in the label) */
+        int l = 1, c = 1, used = 0;
+        const char *msg = verrbuf;
+        if (sscanf(verrbuf, "VALUE:%d:%d: %n", &l, &c, &used) == 2 && used > 0)
+            msg = verrbuf + used;
+        return murk_err_file(err, errlen, label, "the value after '=' is not valid YAML: %s", msg);
     }
     murk_ynode *value = vdoc.root;
     vdoc.root = NULL;
     free(vdoc.file);
     if (!value) {
-        value = murk_ynode_new(MURK_Y_SCALAR, SETFILE, 1, 1);
+        value = murk_ynode_new(MURK_Y_SCALAR, label, 0, 0);
         value->str = murk_strdup("");
         value->plain = 1;
     }
-    retag(value, SETFILE, value_col - 1);
+    retag(value, label);
 
     if (!doc->root)
-        doc->root = murk_ynode_new(MURK_Y_MAP, SETFILE, 1, 1);
+        doc->root = murk_ynode_new(MURK_Y_MAP, label, 0, 0);
     murk_ynode *cur = doc->root;
     const char *seg = assignment;
     for (;;) {
         const char *dot = memchr(seg, '.', (size_t)(eq - seg));
         const char *end = dot ? dot : eq;
         size_t len = (size_t)(end - seg);
-        int col = (int)(seg - assignment) + 1;
+        if (len == 0) {
+            murk_ynode_free(value);
+            return murk_err_file(err, errlen, label, "empty key in '%.*s'", (int)(eq - assignment), assignment);
+        }
         char *key = murk_xmalloc(len + 1);
         memcpy(key, seg, len);
-        if (len == 0) {
-            free(key);
-            murk_ynode_free(value);
-            murk_err_at(err, errlen, SETFILE, 1, col, "empty key in '%.*s'", (int)(eq - assignment), assignment);
-            return -1;
-        }
         murk_ynode **slot = NULL;
         if (cur->kind == MURK_Y_SEQ) {
             if (!is_index(key) || strtoul(key, NULL, 10) >= cur->n) {
-                murk_err_at(err, errlen, SETFILE, 1, col, "'%s' is not an index of this list (it has %zu items)", key,
-                         cur->n);
+                murk_err_file(err, errlen, label, "'%s' is not an index of the list %.*s (it has %zu items)", key,
+                              (int)(seg - assignment - (seg > assignment)), assignment, cur->n);
                 free(key);
                 murk_ynode_free(value);
                 return -1;
@@ -395,14 +398,17 @@ int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errl
                 if (strcmp(cur->keys[i], key) == 0)
                     slot = &cur->items[i];
             if (!slot) {
-                murk_ynode *fresh = murk_ynode_new(dot ? MURK_Y_MAP : MURK_Y_SCALAR, SETFILE, 1, col);
-                append(cur, fresh, key, SETFILE, 1, col);
+                murk_ynode *fresh = murk_ynode_new(dot ? MURK_Y_MAP : MURK_Y_SCALAR, label, 0, 0);
+                append(cur, fresh, key, label, 0, 0);
                 slot = &cur->items[cur->n - 1];
             } else {
+                if (!dot && !strcmp(key, "type") && !cur->swapped_type && (*slot)->kind == MURK_Y_SCALAR &&
+                    !murk_yfrom_set((*slot)->file))
+                    cur->swapped_type = murk_strdup((*slot)->str); /* the file's plugin, whose keys may go */
                 free(key);
             }
         } else {
-            murk_err_at(err, errlen, SETFILE, 1, col, "cannot descend into a scalar at '%s'", key);
+            murk_err_file(err, errlen, label, "cannot descend into a scalar at '%s'", key);
             free(key);
             murk_ynode_free(value);
             return -1;

@@ -19,12 +19,15 @@ struct murk_ynode {
     murk_ynode **items;
     char **keys;      /* MAP only */
     int *key_line, *key_col;
-    const char **key_file; /* where each key was written: the document's file, or "--set" */
+    const char **key_file; /* where each key was written: the document's file, or a --set's label */
+    char *swapped_type; /* MAP only: the file's `type` that a --set replaced (its keys may be dropped) */
 };
 
 typedef struct murk_ydoc {
     char *file;
     murk_ynode *root; /* NULL for an empty document */
+    char **sets;      /* "--set KEY.PATH=VALUE": the file name of the nodes each --set made */
+    size_t nsets;
 } murk_ydoc;
 
 /* Returns 0, or -1 with err = "file:line:col: message". */
@@ -34,8 +37,13 @@ void murk_ydoc_free(murk_ydoc *doc);
 
 murk_ynode *murk_ymap_get(const murk_ynode *map, const char *key); /* NULL if absent or not a map */
 /* Applies "a.b.0.c=VALUE" (VALUE parsed as YAML; sequence indices are numbers). Missing map levels are
- * created. Errors name "--set:1:COL". The replacement nodes keep "--set" as their file. */
+ * created. The nodes it makes (and the keys it adds) have the file "--set a.b.0.c=VALUE" and line 0, so
+ * that every error about them quotes the --set: "--set a.b.0.c=VALUE: what is wrong"; its own errors
+ * (a malformed assignment or value, a path that does not fit the document) read the same way. A --set
+ * of `type` in a map whose `type` came from the file keeps the file's value in swapped_type. */
 int murk_ydoc_set(murk_ydoc *doc, const char *assignment, char *err, size_t errlen);
+/* 1 if the node (or key) was written by a --set: its file is a --set's label. */
+int murk_yfrom_set(const char *file);
 murk_ynode *murk_ynode_new(murk_ykind kind, const char *file, int line, int col);
 void murk_ynode_free(murk_ynode *n);
 /* "file:line:col: " prefix for a node, or for a map key when key_index >= 0. */

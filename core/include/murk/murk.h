@@ -49,7 +49,11 @@ typedef struct murk_render_result {
     double thread_seconds;
 } murk_render_result;
 
-/* `sets` are "KEY.PATH=VALUE" overrides. NULL with a one-line "file:line:col: message" in err. */
+/* `sets` are "KEY.PATH=VALUE" overrides. NULL with a one-line "file:line:col: message" in err
+ * ("--set KEY.PATH=VALUE: message" for an error an override caused). A --set of a plugin's `type` drops
+ * the file's keys of the previous plugin that the new one does not take; a medium or material that a
+ * --set creates and nothing uses is refused (a misspelt name). The murk command also refuses the scene
+ * file's own unused media and materials; this function loads them, for embedders that call them. */
 murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen);
 void murk_scene_free(murk_scene *scene);
 /* 0, or -1 with a one-line message in err (a checkpoint that cannot be read, is of another scene, or

@@ -1,0 +1,222 @@
+/* info.c — `murk info SCENE.yaml [--set KEY.PATH=VALUE ...]`: loads a scene as `murk render` does (same
+ * checks, same messages) and lists what it holds: render settings, camera, integrator, media (tracker,
+ * transmittance estimator, density, majorant grid), materials, shapes (material, interior, exterior) and
+ * every plugin loaded, with its file. Renders nothing. Part of the murk executable, not of libmurk. */
+#include "cli.h"
+#include "density.h"
+#include "media.h"
+#include "scene.h"
+#include "util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A scene node inline, as YAML flow ("[0.5, 0.5, 0.5]", "{ seed: 7, coverage: 0.7 }"), made printable;
+ * keys in skip[] are left out of a map. */
+static void put_node(const murk_ynode *n, const char *const *skip, size_t nskip)
+{
+    char buf[1024];
+    if (!n) {
+        fputs("~", stdout);
+        return;
+    }
+    if (n->kind == MURK_Y_SCALAR) {
+        fputs(murk_printable(buf, sizeof buf, n->str), stdout);
+        return;
+    }
+    int map = n->kind == MURK_Y_MAP, first = 1;
+    fputs(map ? "{ " : "[", stdout);
+    for (size_t i = 0; i < n->n; i++) {
+        int skipped = 0;
+        for (size_t k = 0; map && k < nskip; k++)
+            skipped |= !strcmp(n->keys[i], skip[k]);
+        if (skipped)
+            continue;
+        fputs(first ? "" : ", ", stdout);
+        first = 0;
+        if (map)
+            printf("%s: ", murk_printable(buf, sizeof buf, n->keys[i]));
+        put_node(n->items[i], NULL, 0);
+    }
+    fputs(map ? (first ? "}" : " }") : "]", stdout);
+}
+
+/* A plugin block's own keys after its name: "diffuse { albedo: 0.5 }", or the name alone. */
+static void put_block(const murk_plugin *p, const murk_ynode *block, const char *const *skip, size_t nskip)
+{
+    printf("%s", p->desc->name);
+    size_t shown = 0;
+    for (size_t i = 0; block && block->kind == MURK_Y_MAP && i < block->n; i++) {
+        int skipped = 0;
+        for (size_t k = 0; k < nskip; k++)
+            skipped |= !strcmp(block->keys[i], skip[k]);
+        shown += !skipped;
+    }
+    if (shown) {
+        putchar(' ');
+        put_node(block, skip, nskip);
+    }
+}
+
+static void put_vec(const char *label, murk_vec3 v) { printf("%s [%g, %g, %g]", label, v.x, v.y, v.z); }
+static void put_rgb(const char *label, murk_rgb c) { printf("%s [%g, %g, %g]", label, c.c[0], c.c[1], c.c[2]); }
+
+static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
+{
+    static const char *const own[] = {"type", "density", "transmittance", "sigma_a", "sigma_s", "scale", "g",
+                                      "majorant_factor", "majorant_resolution"};
+    char buf[256];
+    printf("  %s\n    tracker        ", murk_printable(buf, sizeof buf, nm->name));
+    put_block(nm->plugin, block, own, sizeof own / sizeof own[0]);
+    printf("\n    transmittance  ");
+    const murk_plugin *tp = nm->tr_plugin;
+    const murk_ynode *tn = murk_ymap_get(block, "transmittance");
+    static const char *const type_only[] = {"type"};
+    if (tp)
+        put_block(tp, tn, type_only, 1);
+    else
+        printf("the tracker's own (%s)", nm->plugin->desc->name);
+    const murk_medium_data *md = &nm->data;
+    printf("\n    coefficients  ");
+    put_rgb(" sigma_a", md->sigma_a);
+    put_rgb(", sigma_s", md->sigma_s);
+    printf(" (per unit density, scale applied), g %g\n", md->g);
+    const murk_ynode *dn = murk_ymap_get(block, "density");
+    const murk_field *f;
+    const murk_bound_grid *g;
+    float factor;
+    murk_density_parts(nm->density, &f, &g, &factor);
+    int res[3];
+    const float *data;
+    murk_field_grid(f, res, &data);
+    printf("    density        ");
+    if (dn)
+        put_node(dn, NULL, 0);
+    else
+        printf("{ constant: 1 } (default)");
+    if (data)
+        printf(": grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g], max %g", res[0], res[1], res[2], g->lo.x,
+               g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z, murk_field_max(f));
+    else
+        printf(": constant %g, everywhere", murk_field_max(f));
+    float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s));
+    printf("\n    majorant       %dx%dx%d cells, majorant_factor %g; largest majorant %g (extinction %g x density "
+           "%g x factor)\n", g->res[0], g->res[1], g->res[2], factor,
+           (double)(st * murk_field_max(f) * factor), st, murk_field_max(f));
+}
+
+static const char *medium_name(const murk_medium *m) { return m ? m->name : "vacuum"; }
+
+static void info_scene(const murk_scene *s, const char *path, const char *const *sets, size_t nsets)
+{
+    char buf[1024];
+    const murk_ynode *root = s->doc.root;
+    printf("scene       %s\n", murk_printable(buf, sizeof buf, path));
+    for (size_t i = 0; i < nsets; i++)
+        printf("%s%s\n", i ? "            --set " : "overrides   --set ", murk_printable(buf, sizeof buf, sets[i]));
+    printf("render      %dx%d, %d spp, seed %llu, exposure %g\n", s->width, s->height, s->spp,
+           (unsigned long long)s->seed, s->exposure);
+    printf("camera     ");
+    put_vec(" from", s->cam_from);
+    put_vec(" at", s->cam_at);
+    put_vec(" up", s->cam_up);
+    printf(", fov %g, starts in %s\n", s->fov, medium_name(s->camera_medium));
+    put_rgb("background ", s->background);
+    printf("\nintegrator  ");
+    static const char *const type_only[] = {"type"};
+    put_block(s->integrator_plugin, murk_ymap_get(root, "integrator"), type_only, 1);
+    const murk_ynode *media = murk_ymap_get(root, "media");
+    printf("\nmedia (%zu)\n", s->nmedia);
+    for (size_t i = 0; i < s->nmedia; i++)
+        info_medium(&s->media[i], murk_ymap_get(media, s->media[i].name));
+    const murk_ynode *mats = murk_ymap_get(root, "materials");
+    printf("materials (%zu)\n", s->nmaterials);
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        printf("  %-14s ", murk_printable(buf, sizeof buf, s->materials[i].name));
+        put_block(s->materials[i].plugin, murk_ymap_get(mats, s->materials[i].name), type_only, 1);
+        putchar('\n');
+    }
+    static const char *const shape_type[] = {"quad", "sphere", "box", "mesh"};
+    const murk_ynode *shapes = murk_ymap_get(root, "shapes");
+    printf("shapes (%zu)\n", s->nshapes);
+    for (size_t i = 0; i < s->nshapes; i++) {
+        const murk_shape *sh = &s->shapes[i];
+        printf("  %-3zu %-6s material %s, interior %s, exterior %s", i, shape_type[sh->type],
+               sh->material ? sh->material->name : "none (index-matched boundary)", medium_name(sh->interior),
+               medium_name(sh->exterior));
+        if (!murk_rgb_is_black(sh->emission))
+            put_rgb(", emission", sh->emission);
+        const murk_ynode *file = sh->type == MURK_SHAPE_MESH ? murk_ymap_get(shapes->items[i], "file") : NULL;
+        if (file)
+            printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, file->str), sh->ntris);
+        putchar('\n');
+    }
+    printf("plugins (%zu)\n", s->reg.nloaded);
+    for (size_t i = 0; i < s->reg.nloaded; i++) {
+        const murk_plugin *p = s->reg.loaded[i];
+        printf("  %-13s %-16s %s (version %s, ABI %u.%u)\n", murk_kind_name((int)p->desc->kind), p->desc->name,
+               murk_printable(buf, sizeof buf, p->path), p->version ? p->version : "none", p->abi.major, p->abi.minor);
+    }
+}
+
+murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets)
+{
+    char err[2048];
+    murk_scene *s = murk_scene_load(path, sets, nsets, err, sizeof err);
+    if (s && murk_scene_check_unused(s, err, sizeof err)) {
+        murk_scene_free(s);
+        s = NULL;
+    }
+    if (!s)
+        fprintf(stderr, "%s\n", err);
+    return s;
+}
+
+int murk_cli_info(int argc, char **argv)
+{
+    const char *scene_path = NULL;
+    const char **sets = murk_xmalloc(((size_t)argc + 1) * sizeof *sets);
+    size_t nsets = 0;
+    char buf[1024], buf2[1024];
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--set")) {
+            if (i + 1 >= argc) {
+                free(sets);
+                fprintf(stderr, "murk: --set needs KEY.PATH=VALUE\n");
+                return 2;
+            }
+            sets[nsets++] = argv[++i];
+        } else if (!strncmp(a, "--set=", 6)) {
+            sets[nsets++] = a + 6;
+        } else if (a[0] == '-' && a[1]) {
+            free(sets);
+            fprintf(stderr, "murk: unknown info option '%s'\nusage: murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n",
+                    murk_printable(buf, sizeof buf, a));
+            return 2;
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            free(sets);
+            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n",
+                    murk_printable(buf, sizeof buf, scene_path), murk_printable(buf2, sizeof buf2, a));
+            return 2;
+        }
+    }
+    if (!scene_path) {
+        free(sets);
+        fprintf(stderr, "murk: info needs a scene file\nusage: murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n");
+        return 2;
+    }
+    murk_scene *s = murk_cli_load(scene_path, sets, nsets);
+    if (!s) {
+        free(sets);
+        return 1;
+    }
+    info_scene(s, scene_path, sets, nsets);
+    murk_scene_free(s);
+    free(sets);
+    return 0;
+}

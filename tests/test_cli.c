@@ -1,0 +1,169 @@
+/* test_cli.c — the murk command's own surface: `murk --help`, `murk help [COMMAND]` and `murk COMMAND
+ * --help` print usage on stdout and exit 0 for every subcommand; unknown options and commands exit 2 with
+ * the usage on stderr and nothing on stdout; `murk info` lists what a scene holds (camera, render
+ * settings, media with tracker, estimator, grid and majorant, materials, shapes, plugins with paths),
+ * with --set applied and checked as `murk render` checks it. */
+#include "testutil.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const commands[] = {"render", "info", "plugins", "compare", "check", "grid", "help"};
+#define NCOMMANDS (sizeof commands / sizeof commands[0])
+
+static void expect_help(const char *what, int st, const char *out, const char *err, const char *usage_of)
+{
+    if (st != 0 || err[0])
+        fail_msg("[%s] exit %d (want 0), stderr:\n%s", what, st, err);
+    char want[128];
+    snprintf(want, sizeof want, "usage: murk %s", usage_of);
+    assert_contains(out, want);
+}
+
+static void test_help_everywhere(void **state)
+{
+    (void)state;
+    char *out, *err;
+    /* the whole usage: every command named in it */
+    static const char *const whole[][2] = {{"--help", NULL}, {"-h", NULL}, {"help", NULL}};
+    for (size_t k = 0; k < 3; k++) {
+        int st = run_murk_split(&out, &err, whole[k]);
+        if (st != 0 || err[0])
+            fail_msg("[murk %s] exit %d, stderr:\n%s", whole[k][0], st, err);
+        for (size_t i = 0; i < NCOMMANDS; i++) {
+            char want[64];
+            snprintf(want, sizeof want, "murk %s", commands[i]);
+            assert_contains(out, want);
+        }
+        free(out);
+        free(err);
+    }
+    /* one command's: murk COMMAND --help, murk COMMAND -h, murk help COMMAND; also after other arguments */
+    for (size_t i = 0; i < NCOMMANDS; i++) {
+        const char *forms[][4] = {{commands[i], "--help", NULL}, {commands[i], "-h", NULL},
+                                  {"help", commands[i], NULL}, {commands[i], "x.yaml", "--help", NULL}};
+        for (size_t f = 0; f < 4; f++) {
+            char what[96];
+            snprintf(what, sizeof what, "murk %s %s%s", forms[f][0], forms[f][1], forms[f][2] ? " --help" : "");
+            int st = run_murk_split(&out, &err, forms[f]);
+            expect_help(what, st, out, err, commands[i]);
+            free(out);
+            free(err);
+        }
+    }
+    /* what render's help says about the A/B rules */
+    const char *const rh[] = {"render", "--help", NULL};
+    run_murk_split(&out, &err, rh);
+    assert_contains(out, "--set KEY.PATH=VALUE");
+    assert_contains(out, "drops the file's keys");
+    assert_contains(out, "nothing uses is an error");
+    free(out);
+    free(err);
+    /* an option's value that happens to read -h is that option's, not a request for help */
+    const char *const val[] = {"render", "x.yaml", "-o", "-h", NULL};
+    assert_int_equal(run_murk_split(&out, &err, val), 2);
+    assert_contains(err, "the output file must end in .exr, got '-h'");
+    free(out);
+    free(err);
+}
+
+/* Unknown options and commands: exit 2, the usage on stderr, nothing on stdout. */
+static void test_unknown_options(void **state)
+{
+    (void)state;
+    static const char *const cases[][4] = {
+        {"render", "--bogus", NULL}, {"info", "x.yaml", "--bogus", NULL}, {"plugins", "--bogus", NULL},
+        {"compare", "--bogus", "a.exr", NULL}, {"check", "--bogus", NULL}, {"grid", "--bogus", NULL},
+        {"frobnicate", NULL}, {"help", "frobnicate", NULL}, {"--bogus", NULL},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        char *out, *err;
+        int st = run_murk_split(&out, &err, cases[i]);
+        if (st != 2 || out[0])
+            fail_msg("[murk %s %s] exit %d (want 2), stdout:\n%s\nstderr:\n%s", cases[i][0],
+                     cases[i][1] ? cases[i][1] : "", st, out, err);
+        assert_contains(err, "usage");
+        free(out);
+        free(err);
+    }
+}
+
+static void test_info(void **state)
+{
+    (void)state;
+    char *out, *err;
+    char smoke[1024];
+    snprintf(smoke, sizeof smoke, "%s", src_path("scenes/cornell_smoke.yaml"));
+    const char *const a[] = {"info", smoke, "--set", "media.smoke.type=decomposition", "--set",
+                             "media.smoke.transmittance=ratio", "--set", "media.smoke.majorant_factor=2", NULL};
+    int st = run_murk_split(&out, &err, a);
+    if (st != 0)
+        fail_msg("murk info failed (%d):\n%s", st, err);
+    static const char *const want[] = {
+        "overrides   --set media.smoke.type=decomposition",
+        "render      512x512, 128 spp, seed 0",
+        "camera      from [0, 1, 3.4] at [0, 1, 0] up [0, 1, 0], fov 40, starts in vacuum",
+        "integrator  volpath_nee { max_depth: 64 }",
+        "media (1)\n  smoke\n    tracker        decomposition\n    transmittance  ratio\n",
+        "sigma_a [0.5, 0.5, 0.5], sigma_s [18, 18, 18]",
+        "grid 64x64x64 voxels over [-0.6, 0.05, -0.6]-[0.6, 1.45, 0.6], max 1",
+        "majorant       14x16x14 cells, majorant_factor 2; largest majorant 37",
+        "materials (4)\n  white          diffuse { albedo: [0.73, 0.73, 0.73] }",
+        "shapes (7)\n  0   quad   material white, interior vacuum, exterior vacuum\n",
+        "  5   quad   material light, interior vacuum, exterior vacuum, emission [17, 12, 4]\n",
+        "  6   box    material none (index-matched boundary), interior smoke, exterior vacuum\n",
+        "plugins (4)\n",
+        "/plugins/decomposition.so (version ",
+        "/plugins/ratio.so (version ",
+        "/plugins/volpath_nee.so (version ",
+        "/plugins/diffuse.so (version ",
+    };
+    for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+        assert_contains(out, want[i]);
+    assert_not_contains(out, "delta.so"); /* the file's tracker was swapped, never loaded */
+    free(out);
+    free(err);
+
+    /* a mesh shape, a constant density, an exterior medium */
+    const char *p = write_tmp("info.yaml", "murk: 1\n"
+                                           "camera: { medium: air }\n"
+                                           "materials: { m: { type: ggx, roughness: 0.25 } }\n"
+                                           "media:\n"
+                                           "  air: { type: delta, sigma_s: 0.1 }\n"
+                                           "  ink: { type: spectral, density: { constant: 2 }, sigma_a: [1, 2, 3] }\n"
+                                           "shapes:\n"
+                                           "  - { type: sphere, center: [0, 0, 0], radius: 1, material: m, "
+                                           "interior: ink, exterior: air }\n");
+    const char *const b[] = {"info", p, NULL};
+    st = run_murk_split(&out, &err, b);
+    if (st != 0)
+        fail_msg("murk info failed (%d):\n%s", st, err);
+    assert_contains(out, "starts in air");
+    assert_contains(out, "  m              ggx { roughness: 0.25 }");
+    assert_contains(out, "  ink\n    tracker        spectral\n    transmittance  the tracker's own (spectral)");
+    assert_contains(out, "density        { constant: 2 }: constant 2, everywhere");
+    assert_contains(out, "  0   sphere material m, interior ink, exterior air\n");
+    free(out);
+    free(err);
+
+    /* the same errors as murk render, nothing on stdout */
+    const char *const c[] = {"info", smoke, "--set", "media.smok.type=spectral", NULL};
+    assert_int_equal(run_murk_split(&out, &err, c), 1);
+    assert_string_equal(out, "");
+    assert_string_equal(err, "--set media.smok.type=spectral: media.smok is not used by any shape or by the camera; "
+                             "did you mean media.smoke?\n");
+    free(out);
+    free(err);
+}
+
+int main(void)
+{
+    unsetenv("MURK_PLUGIN_PATH");
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_help_everywhere),
+        cmocka_unit_test(test_unknown_options),
+        cmocka_unit_test(test_info),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
