@@ -16,6 +16,15 @@
  *              furnace    the directional albedo E(wo) = mean of f |cos| / pdf must not exceed 1 by
  *                         more than 4 standard errors (energy conservation).
  *              reciprocity f(wo, wi) = f(wi, wo) for 4096 random pairs above the surface (relative 1e-3).
+ *            A material that transmits (some sample with wi.z < 0 at 45 degrees from either side) also gets:
+ *              eta        the indices s->eta reports (at most 3, those from inside the inverses of those
+ *                         from outside);
+ *              chi2, furnace from inside (the hit's n against ng), the furnace counting transmitted light as
+ *                         energy (x each channel's eta^2);
+ *              reciprocity across the surface: f(a, b) / eta_a^2 = f(b, a) / eta_b^2 for a outside, b
+ *                         inside, each seen from its own side: per channel the ratio a constant on 4096
+ *                         pairs (relative 1e-3), and that constant the square of an index s->eta reports;
+ *                         and f(wo, wi) = f(wi, wo) for pairs both inside.
  * medium     (a tracker) on a ray through a homogeneous slab (density 0.5, closed-form optical depth
  *            0.75) and through a checker grid (8^3 voxels alternating 0.2 / 1.4, a ray along voxel
  *            centres: optical depth = voxel size x the sum of the row), each with grey
@@ -296,7 +305,7 @@ static int learn_eta(ck *c, const mat_ref *out, const mat_ref *in, const char *l
     char line[256] = "";
     size_t k = 0;
     for (int side = 0; side < 2; side++) {
-        k += (size_t)snprintf(line + k, sizeof line - k, "%s", side ? "; inside" : " outside");
+        k += (size_t)snprintf(line + k, sizeof line - k, "%s%s", side ? "; inside" : " outside", n[side] ? "" : " none");
         for (int i = 0; i < n[side] && k < sizeof line; i++) {
             k += (size_t)snprintf(line + k, sizeof line - k, " %.5g", seen[side][i]);
             if (side) { /* the inverse of one seen from outside */
@@ -399,6 +408,11 @@ static void check_reciprocity_tr(ck *c, const mat_ref *out, const mat_ref *in, c
         if (!nq)
             len += (size_t)snprintf(line + len, sizeof line - len, " -");
     }
+    len += (size_t)snprintf(line + len, sizeof line - len, " (s->eta:");
+    for (int i = 0; i < CK_MAX_ETA && eta[i] > 0.0 && len < sizeof line; i++)
+        len += (size_t)snprintf(line + len, sizeof line - len, " %.5g", eta[i]);
+    if (len < sizeof line)
+        snprintf(line + len, sizeof line - len, ")");
     report(c, ok, "reciprocity %-28s transmission f(a,b)/eta_a^2 = f(b,a)/eta_b^2 on 4096 pairs: max rel diff %.2e, eta per channel%s",
            label, worst, line);
     report(c, bad_in == 0, "reciprocity %-28s inside f(wo,wi) = f(wi,wo) on 4096 pairs: max rel diff %.2e", label, worst_in);
