@@ -9,7 +9,8 @@
  *              light: every emitting triangle uniformly by area, or a rectangular quad or box face
  *              uniformly in the solid angle it subtends (Urena et al. 2013; tiny ones and other shapes
  *              by area). solid_angle is far less noisy for points close to a light, but costs more per
- *              sample and did not lower the error of whole images (docs/results.md).
+ *              sample, did not lower the error of whole images, and renders one test scene 0.1 %
+ *              brighter than area does, unexplained (docs/results.md): experimental.
  *   rr_threshold  float in [0.001, 1], default 1: Russian roulette keeps a path with probability
  *              min(1, weight / rr_threshold) (at least 0.05): 1 plays with every path whose weight fell
  *              below 1, 0.1 only with the paths below a tenth (longer paths, less noise per sample, no
