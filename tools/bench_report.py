@@ -264,9 +264,11 @@ def report(d, meta, agg, shares):
          "- budgets: %s per render, each with %d seeds; variants: %d" % ("seconds (equal time)" if unit == "s" else "spp",
                                                                        meta["repeat"], len(meta["variants"])),
          "- reference: `%s` (%s)" % (meta["reference"]["path"], "given" if meta["reference"]["given"] else
-                                     "%d spp, %s" % (meta["reference"]["spp"],
-                                                     "reused from the cache" if meta["reference"]["reused"]
-                                                     else "rendered for this run and cached")),
+                                     "%d spp of %s, %s" % (meta["reference"]["spp"],
+                                                           " ".join("`--set %s`" % x for x in meta["reference"]["sets"])
+                                                           or "the first variant, '%s'" % meta["variants"][0],
+                                                           "reused from the cache" if meta["reference"]["reused"]
+                                                           else "rendered for this run and cached")),
          "- relMSE = mean over pixels and channels of ((a − r)² − v) / (r² + 0.01), r the reference, v the estimated "
          "variance of its per-pixel mean (0 for a given reference): an unbiased estimate of a render's own relMSE. "
          "Error bars: the standard error over the seeds.",

@@ -132,7 +132,7 @@ typedef struct bench {
     int nbudgets, time_mode, repeat, threads, ref_spp, charts;
 } bench;
 
-enum { REF_CHUNKS = 4 };
+enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
 
 static char **split_list(const char *s, int *n)
 {
@@ -877,6 +877,9 @@ int murk_cli_bench(int argc, char **argv)
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1]) {
                 fprintf(stderr, "murk: --vary needs KEY.PATH=V1,V2,..., got '%s'\n", murk_cli_q(v));
+                rc = 2;
+            } else if (b.nvary == MAX_VARY) {
+                fprintf(stderr, "murk: at most %d --vary\n", MAX_VARY);
                 rc = 2;
             } else {
                 vary *x = &b.vary[b.nvary++];
