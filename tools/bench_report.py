@@ -14,9 +14,12 @@ import os
 import platform
 import sys
 
+import warnings
+
 import matplotlib
 
 matplotlib.use("Agg")
+warnings.filterwarnings("ignore", category=RuntimeWarning)  # all-NaN bars of a scene without media
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
@@ -106,7 +109,8 @@ def error_chart(d, meta, agg, cost, xlabel, name):
     ax.set_xlabel(xlabel)
     ax.set_ylabel("relMSE (noise-corrected), mean ± s.e. over seeds")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    if not empty:
+        ax.legend(fontsize=8)
     save(fig, d, name)
 
 
@@ -214,7 +218,7 @@ def summary(meta, agg, shares):
         for v in range(nv):
             e, se = efficiency(agg[v][big], cost)
             e0, se0 = efficiency(agg[0][big], cost)
-            r, sr = ratio(e, se, e0, se0) if v else (1.0, 0.0)
+            r, sr = ratio(e, se, e0, se0) if v else ((1.0, 0.0) if e0 == e0 else (float("nan"), float("nan")))
             rs.append((r, sr, v))
         ok = [x for x in rs if x[0] == x[0]]
         if not ok:
