@@ -1,6 +1,7 @@
 /* test_bench.c — `murk bench` end to end on a tiny scene (rows, charts, report, a wrong --vary caught
- * before rendering, the cached reference reused and then invalidated), and the noise-corrected relMSE
- * of metrics.c (the code murk bench and murk compare share). */
+ * before rendering, the cached reference reused and then invalidated), the noise-corrected relMSE
+ * of metrics.c (the code murk bench and murk compare share), and murk compare's bias test, --json,
+ * --crop and maps. */
 #include "testutil.h"
 
 #include "metrics.h"
@@ -58,9 +59,7 @@ static int csv_rows(const char *dir)
 static void bench_end_to_end(void **state)
 {
     (void)state;
-    char cache[512], out1[512], out2[512], out3[512];
-    snprintf(cache, sizeof cache, "%s/cache", tmp_dir());
-    setenv("MURK_CACHE_DIR", cache, 1);
+    char out1[512], out2[512], out3[512];
     snprintf(out1, sizeof out1, "%s/b1", tmp_dir());
     snprintf(out2, sizeof out2, "%s/b2", tmp_dir());
     snprintf(out3, sizeof out3, "%s/b3", tmp_dir());
@@ -191,11 +190,53 @@ static void corrected_relmse_of_two_seeds(void **state)
     free(a), free(va), free(b), free(vb), free(v);
 }
 
+/* murk compare on two renders of another seed: the bias test finds no difference (|z| < 4), --json and
+ * --crop give one JSON object over the crop, --diff writes the heat map and the signed map beside it,
+ * and the efficiency comes from the EXR's render time and counters. */
+static void compare_two_seeds(void **state)
+{
+    (void)state;
+    const char *scene = write_tiny("[0.2, 0.2, 0.2]");
+    char a[512], b[512], diff[512], sdiff[512], *out = NULL;
+    snprintf(a, sizeof a, "%s/cmp_a.exr", tmp_dir());
+    snprintf(b, sizeof b, "%s/cmp_b.exr", tmp_dir());
+    snprintf(diff, sizeof diff, "%s/cmp_diff.png", tmp_dir());
+    snprintf(sdiff, sizeof sdiff, "%s/cmp_diff_signed.png", tmp_dir());
+    assert_int_equal(run_murk(&out, "render", scene, "-o", a, "--spp", "8", "--quiet", NULL), 0);
+    free(out);
+    assert_int_equal(run_murk(&out, "render", scene, "-o", b, "--spp", "8", "--quiet", "--set", "render.seed=9", NULL),
+                     0);
+    free(out);
+    assert_int_equal(run_murk(&out, "compare", a, b, "--diff", diff, NULL), 0);
+    assert_contains(out, "no sign of a different expected image");
+    assert_contains(out, "efficiency 1/(relMSE x seconds)");
+    assert_contains(out, "efficiency 1/(relMSE x density lookups)");
+    assert_contains(out, "blue -1 .. white 0 .. red +1");
+    const char *z = strstr(out, "(z = ");
+    assert_non_null(z);
+    assert_true(fabs(atof(z + 5)) < 4.0);
+    free(out);
+    struct stat st;
+    assert_int_equal(stat(diff, &st), 0);
+    assert_int_equal(stat(sdiff, &st), 0);
+    assert_int_equal(run_murk(&out, "compare", a, b, "--json", "--crop", "4,4,8,8", NULL), 0);
+    assert_contains(out, "\"crop\": [4, 4, 8, 8], \"n\": 192,");
+    assert_contains(out, "\"z\": ");
+    free(out);
+    assert_int_equal(run_murk(&out, "compare", a, b, "--crop", "20,20,8,8", NULL), 2);
+    assert_contains(out, "reaches outside the 24x24 images");
+    free(out);
+}
+
 int main(void)
 {
+    char cache[512]; /* no test writes a reference into the user's cache */
+    snprintf(cache, sizeof cache, "%s/cache", tmp_dir());
+    setenv("MURK_CACHE_DIR", cache, 1);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(bench_bad_vary),
         cmocka_unit_test(corrected_relmse_of_two_seeds),
+        cmocka_unit_test(compare_two_seeds),
         cmocka_unit_test(bench_end_to_end),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,9 +14,12 @@ import os
 import platform
 import sys
 
+import warnings
+
 import matplotlib
 
 matplotlib.use("Agg")
+warnings.filterwarnings("ignore", category=RuntimeWarning)  # all-NaN bars of a scene without media
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
@@ -106,7 +109,8 @@ def error_chart(d, meta, agg, cost, xlabel, name):
     ax.set_xlabel(xlabel)
     ax.set_ylabel("relMSE (noise-corrected), mean ± s.e. over seeds")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    if not empty:
+        ax.legend(fontsize=8)
     save(fig, d, name)
 
 
@@ -214,7 +218,7 @@ def summary(meta, agg, shares):
         for v in range(nv):
             e, se = efficiency(agg[v][big], cost)
             e0, se0 = efficiency(agg[0][big], cost)
-            r, sr = ratio(e, se, e0, se0) if v else (1.0, 0.0)
+            r, sr = ratio(e, se, e0, se0) if v else ((1.0, 0.0) if e0 == e0 else (float("nan"), float("nan")))
             rs.append((r, sr, v))
         ok = [x for x in rs if x[0] == x[0]]
         if not ok:
@@ -264,9 +268,11 @@ def report(d, meta, agg, shares):
          "- budgets: %s per render, each with %d seeds; variants: %d" % ("seconds (equal time)" if unit == "s" else "spp",
                                                                        meta["repeat"], len(meta["variants"])),
          "- reference: `%s` (%s)" % (meta["reference"]["path"], "given" if meta["reference"]["given"] else
-                                     "%d spp, %s" % (meta["reference"]["spp"],
-                                                     "reused from the cache" if meta["reference"]["reused"]
-                                                     else "rendered for this run and cached")),
+                                     "%d spp of %s, %s" % (meta["reference"]["spp"],
+                                                           " ".join("`--set %s`" % x for x in meta["reference"]["sets"])
+                                                           or "the first variant, '%s'" % meta["variants"][0],
+                                                           "reused from the cache" if meta["reference"]["reused"]
+                                                           else "rendered for this run and cached")),
          "- relMSE = mean over pixels and channels of ((a − r)² − v) / (r² + 0.01), r the reference, v the estimated "
          "variance of its per-pixel mean (0 for a given reference): an unbiased estimate of a render's own relMSE. "
          "Error bars: the standard error over the seeds.",

@@ -134,7 +134,7 @@ typedef struct bench {
     int assemble;
 } bench;
 
-enum { REF_CHUNKS = 4 };
+enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
 
 static char **split_list(const char *s, int *n)
 {
@@ -170,16 +170,34 @@ static int variant_value(const bench *b, int i, int k)
     return i % b->vary[k].nvals;
 }
 
-/* "type=delta majorant_factor=4": each --vary key's last component and the variant's value. */
+/* The short name of --vary key j: its last component ("type"), or its last two ("medium.type") when
+ * another --vary key ends the same way. */
+static const char *vary_name(const bench *b, int j)
+{
+    const char *key = b->vary[j].key, *leaf = strrchr(key, '.');
+    leaf = leaf ? leaf + 1 : key;
+    for (int o = 0; o < b->nvary; o++) {
+        const char *ol = strrchr(b->vary[o].key, '.');
+        if (o != j && !strcmp(ol ? ol + 1 : b->vary[o].key, leaf)) {
+            if (leaf == key)
+                return key;
+            const char *p = leaf - 1; /* the '.' before the leaf; back to the start of the component before */
+            while (p > key && p[-1] != '.')
+                p--;
+            return p;
+        }
+    }
+    return leaf;
+}
+
+/* "type=delta majorant_factor=4": each --vary key's short name and the variant's value. */
 static void variant_label(const bench *b, int i, char *buf, size_t n)
 {
     size_t k = 0;
     buf[0] = 0;
-    for (int j = 0; j < b->nvary && k < n; j++) {
-        const char *leaf = strrchr(b->vary[j].key, '.');
-        k += (size_t)snprintf(buf + k, n - k, "%s%s=%s", j ? " " : "", leaf ? leaf + 1 : b->vary[j].key,
+    for (int j = 0; j < b->nvary && k < n; j++)
+        k += (size_t)snprintf(buf + k, n - k, "%s%s=%s", j ? " " : "", vary_name(b, j),
                               b->vary[j].vals[variant_value(b, i, j)]);
-    }
     if (!b->nvary)
         snprintf(buf, n, "scene");
 }
@@ -1061,6 +1079,9 @@ int murk_cli_bench(int argc, char **argv)
             const char *eq = strchr(v, '=');
             if (!eq || eq == v || !eq[1]) {
                 fprintf(stderr, "murk: --vary needs KEY.PATH=V1,V2,..., got '%s'\n", murk_cli_q(v));
+                rc = 2;
+            } else if (b.nvary == MAX_VARY) {
+                fprintf(stderr, "murk: at most %d --vary\n", MAX_VARY);
                 rc = 2;
             } else {
                 vary *x = &b.vary[b.nvary++];
