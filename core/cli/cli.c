@@ -320,7 +320,7 @@ static int cmd_render(int argc, char **argv)
     for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
         k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
     if (opts.checkpoint || opts.resume) {
-        opts.scene_hash = murk_file_hash(scene_path, err, sizeof err);
+        opts.scene_hash = murk_scene_hash(s, err, sizeof err); /* the YAML and every file it loads */
         opts.overrides = setbuf;
         if (!opts.scene_hash) {
             fprintf(stderr, "%s\n", err);
