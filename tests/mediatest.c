@@ -151,6 +151,20 @@ double mt_se(const mt_acc *a, int c) { return sqrt(mt_var(a, c) / (double)a->n);
 
 int mt_hero(murk_rng *rng) { return (int)(murk_rng_float(rng) * 3.0f); }
 
+int mt_call(const murk_medium *m, const murk_ray *ray, murk_rng *rng, murk_rgb *T, murk_medium_event *ev, double x[3])
+{
+    murk_path_ctx ctx;
+    ctx.beta = murk_rgb1(1.0f);
+    ctx.hero = mt_hero(rng);
+    *T = m->vt->transmittance(m->self, ray, &ctx, rng);
+    ctx.hero = mt_hero(rng);
+    m->vt->sample(m->self, ray, &ctx, rng, ev);
+    double mp = ((double)ev->pdf_ratio.c[0] + ev->pdf_ratio.c[1] + ev->pdf_ratio.c[2]) / 3.0;
+    for (int c = 0; c < 3; c++)
+        x[c] = mp > 0.0 ? ev->weight.c[c] / mp : 0.0;
+    return murk_rgb_finite(*T) && murk_rgb_finite(ev->weight) && murk_rgb_finite(ev->pdf_ratio) && isfinite(ev->t);
+}
+
 double mt_seconds(void)
 {
     struct timespec t;

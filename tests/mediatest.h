@@ -84,6 +84,10 @@ double mt_se(const mt_acc *a, int c);  /* the mean's standard error */
 
 /* A uniform hero channel. */
 int mt_hero(murk_rng *rng);
+/* One transmittance() and one sample() call on ray as volpath makes them (ctx.beta = 1, each with a uniform
+ * hero): *T, *ev, and x[c] = the event's weight over the mean pdf ratio (the integrator's weighting: 3x on
+ * naive_spectral's hero, the balance heuristic for spectral_mis). Returns 1 if every result is finite. */
+int mt_call(const murk_medium *m, const murk_ray *ray, murk_rng *rng, murk_rgb *T, murk_medium_event *ev, double x[3]);
 /* Monotonic clock, seconds. */
 double mt_seconds(void);
 

@@ -197,7 +197,7 @@ static void test_bounds_fail(void **state)
     };
     config c = sinus_cfg();
     c.name = "sinusoid, majorant_factor 0.6, scale 0.5";
-    check_config(&c, ", majorant_factor: 0.6, scale: 0.5", 0.5, es, (int)(sizeof es / sizeof es[0]), NULL);
+    check_config(&c, ", majorant_factor: 0.6, majorant_repair: false, scale: 0.5", 0.5, es, (int)(sizeof es / sizeof es[0]), NULL);
     /* the control alone above the density, with a bounding majorant */
     static const mt_spec es2[] = {
         {"residual_ratio_c2", "transmittance: { type: residual_ratio, control: 2 }", 1},

@@ -4,12 +4,31 @@
 
 #include <stddef.h>
 
-/* Runs `murk render | plugins | compare | grid | --version | --help`; returns the exit status. */
+/* Runs `murk render | info | plugins | compare | bench | merge | check | grid | help | --version | --help`;
+ * returns the exit status. */
 int murk_cli_main(int argc, char **argv);
 /* `murk info SCENE.yaml [--set ...]` (info.c). */
 int murk_cli_info(int argc, char **argv);
 /* A scene as the murk command loads it (info.c): murk_scene_load plus the command's rule that every
  * medium and material is used (murk_scene_check_unused). NULL after printing the one-line error. */
 struct murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets);
+
+/* Shared by the subcommands' files. */
+const char *murk_cli_q(const char *s); /* untrusted text made printable (eight rotating buffers) */
+void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
+int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
+
+int murk_cli_compare(int argc, char **argv); /* compare.c */
+int murk_cli_bench(int argc, char **argv);   /* bench.c */
+
+/* The cost counters (murk/counters.h) of a render as JSON for the EXR's murk:counters, and as the
+ * end-of-render summary's lines (bench.c). */
+#include <stdio.h>
+#include "murk/murk.h"
+void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n);
+void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r);
+
+/* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */
+int murk_cli_merge(int argc, char **argv);
 
 #endif

@@ -60,18 +60,10 @@ static void put_block(const murk_plugin *p, const murk_ynode *block, const char 
     }
 }
 
-static const murk_plugin *plugin_of_vtable(const murk_scene *s, const void *vt)
-{
-    for (size_t i = 0; i < s->reg.nloaded; i++)
-        if (s->reg.loaded[i]->desc->vtable == vt)
-            return s->reg.loaded[i];
-    return NULL;
-}
-
 static void put_vec(const char *label, murk_vec3 v) { printf("%s [%g, %g, %g]", label, v.x, v.y, v.z); }
 static void put_rgb(const char *label, murk_rgb c) { printf("%s [%g, %g, %g]", label, c.c[0], c.c[1], c.c[2]); }
 
-static void info_medium(const murk_scene *s, const murk_named_medium *nm, const murk_ynode *block)
+static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
 {
     static const char *const own[] = {"type", "density", "transmittance", "sigma_a", "sigma_s", "scale", "g",
                                       "majorant_factor", "majorant_resolution"};
@@ -79,7 +71,7 @@ static void info_medium(const murk_scene *s, const murk_named_medium *nm, const 
     printf("  %s\n    tracker        ", murk_printable(buf, sizeof buf, nm->name));
     put_block(nm->plugin, block, own, sizeof own / sizeof own[0]);
     printf("\n    transmittance  ");
-    const murk_plugin *tp = nm->m.tr_vt ? plugin_of_vtable(s, nm->m.tr_vt) : NULL;
+    const murk_plugin *tp = nm->tr_plugin;
     const murk_ynode *tn = murk_ymap_get(block, "transmittance");
     static const char *const type_only[] = {"type"};
     if (tp)
@@ -138,7 +130,7 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
     const murk_ynode *media = murk_ymap_get(root, "media");
     printf("\nmedia (%zu)\n", s->nmedia);
     for (size_t i = 0; i < s->nmedia; i++)
-        info_medium(s, &s->media[i], murk_ymap_get(media, s->media[i].name));
+        info_medium(&s->media[i], murk_ymap_get(media, s->media[i].name));
     const murk_ynode *mats = murk_ymap_get(root, "materials");
     printf("materials (%zu)\n", s->nmaterials);
     for (size_t i = 0; i < s->nmaterials; i++) {

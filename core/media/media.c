@@ -11,8 +11,9 @@
  *       sigma_s: [r, g, b]          # scattering per unit density (default 1)
  *       scale: 1                    # multiplies sigma_a and sigma_s
  *       g: 0                        # Henyey-Greenstein asymmetry
- *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (warned)
+ *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (repaired, warned)
  *       majorant_resolution: 16     # majorant grid cells along the field's longest axis
+ *       majorant_repair: true       # cells a factor < 1 left below the density get their exact bound back
  *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
  *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
@@ -36,6 +37,7 @@ struct murk_density {
     murk_field *field;
     murk_bound_grid grid;
     float factor;
+    unsigned slot; /* its medium's cost counters (host.h) */
 };
 
 MURK_API void murk_density_parts(const murk_density *d, const murk_field **field, const murk_bound_grid **grid,
@@ -49,19 +51,27 @@ MURK_API void murk_density_parts(const murk_density *d, const murk_field **field
 typedef struct walk {
     murk_dda dda;
     float factor;
+    murk_counters *count; /* this thread's block for the medium (host.h), taken once per walk */
 } walk;
 
 _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
 
 /* ---- host services ------------------------------------------------------------------------- */
 
-float murk_media_density(const murk_density *d, murk_vec3 p) { return murk_field_eval(d->field, p); }
+float murk_media_density(const murk_density *d, murk_vec3 p)
+{
+    murk_thread_counters[d->slot].lookups++;
+    return murk_field_eval(d->field, p);
+}
+
+murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_counters[d->slot]; }
 
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w)
 {
     walk *k = (walk *)(void *)w;
     murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
     k->factor = d->factor;
+    k->count = &murk_thread_counters[d->slot];
 }
 
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
@@ -69,6 +79,7 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     walk *k = (walk *)(void *)w;
     float mx = 0.0f, mn = 0.0f;
     int r = murk_dda_next(&k->dda, ta, tb, &mx, &mn);
+    k->count->cells += (unsigned)r;
     if (dmax)
         *dmax = mx * k->factor;
     if (dmin)
@@ -215,16 +226,19 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
 /* The keys every medium has, whatever its tracker: read by the core with the same schema reader as a
  * plugin's parameters, and listed with them by `murk plugins TRACKER`. `density` and `transmittance`
  * (maps or names) are read separately (murk_medium_special_keys). */
-enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_COUNT };
+enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_MAJORANT_REPAIR, K_COUNT };
 MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
     [K_SIGMA_A] = {"sigma_a", MURK_PARAM_RGB, 0, {0, 0, 0}, NULL, NULL, 0, 1e8, "absorption per unit density"},
     [K_SIGMA_S] = {"sigma_s", MURK_PARAM_RGB, 0, {1, 1, 1}, NULL, NULL, 0, 1e8, "scattering per unit density"},
     [K_SCALE] = {"scale", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 1e8, "multiplies sigma_a and sigma_s"},
     [K_G] = {"g", MURK_PARAM_FLOAT, 0, {0, 0, 0}, NULL, NULL, -0.99, 0.99, "Henyey-Greenstein asymmetry"},
     [K_MAJORANT_FACTOR] = {"majorant_factor", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 1e-3, 1e3,
-                           "multiplies the majorant grid; < 1 no longer bounds (trackers stay unbiased, noisier)"},
+                           "multiplies the majorant grid; < 1 no longer bounds (repaired, see majorant_repair)"},
     [K_MAJORANT_RESOLUTION] = {"majorant_resolution", MURK_PARAM_INT, 0, {16, 0, 0}, NULL, NULL, 1, 256,
                                "majorant/minorant grid cells along the field box's longest axis"},
+    [K_MAJORANT_REPAIR] = {"majorant_repair", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
+                           "raise majorant cells that majorant_factor < 1 left below the density to their exact bound "
+                           "before rendering; false: trackers repair per flight (unbiased, noisier)"},
 };
 MURK_API const char *const murk_medium_special_keys[2] = {"density", "transmittance"};
 
@@ -259,6 +273,7 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
                                &nm->data, &p, &nm->m.tr_self, err, errlen))
         return -1;
     nm->m.tr_vt = p->desc->vtable;
+    nm->tr_plugin = p;
     return 0;
 }
 
@@ -300,18 +315,37 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     double mf = core[K_MAJORANT_FACTOR].f[0];
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);
+    nm->density->slot = murk_counter_slot(s->nmedia);
     nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
     if (!nm->density->field)
         return -1;
     if (murk_bound_grid_build(nm->density->field, (int)core[K_MAJORANT_RESOLUTION].f[0], &nm->density->grid) != 0)
         return murk_yerr(err, errlen, dn ? dn : m, "%s: cannot build the majorant grid (out of memory)", who);
-    nm->density->factor = (float)mf;
+    /* The deterministic majorant repair (docs/stability.md). Each bound-grid cell holds the exact maximum of
+     * the interpolated field over it (density.h), attained at a voxel, so a factor < 1 leaves every cell
+     * with density below it somewhere: the repair gives each such cell its exact bound back, which is
+     * the factor 1. It happens before rendering and depends on the scene only, so the image stays a pure
+     * function of (scene, seed, spp). Without it the trackers repair per flight (murk/tracking.h). */
+    int repair = core[K_MAJORANT_REPAIR].f[0] != 0.0;
+    nm->density->factor = (float)(repair && mf < 1.0 ? 1.0 : mf);
     md->density = nm->density;
     md->name = nm->name = murk_strdup(name);
-    if (mf < 1.0)
-        murk_log(MURK_LOG_WARN,
-                 "%s: majorant_factor %g < 1: the majorant no longer bounds the density; trackers fall back to "
-                 "weighted collisions (unbiased, noisier)", who, mf);
+    if (mf < 1.0) {
+        const murk_bound_grid *g = &nm->density->grid;
+        size_t n = (size_t)g->res[0] * (size_t)g->res[1] * (size_t)g->res[2], bad = 0;
+        for (size_t i = 0; i < n; i++)
+            bad += g->maj[i] > 0.0f;
+        if (repair)
+            murk_log(MURK_LOG_WARN,
+                     "%s: majorant_factor %g < 1 leaves %zu of %zu majorant cells below the density; murk raised "
+                     "them to their exact bound before rendering (as majorant_factor 1: no bias, no extra noise, "
+                     "the time of a bounding majorant; majorant_repair: false keeps the factor)", who, mf, bad, n);
+        else
+            murk_log(MURK_LOG_WARN,
+                     "%s: majorant_factor %g < 1 with majorant_repair: false: %zu of %zu majorant cells do not bound "
+                     "the density; trackers weight each violating collision and raise that flight's majorant "
+                     "(unbiased; noisier than majorant_repair: true)", who, mf, bad, n);
+    }
     float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s)), sm = fmaxf(1e-30f, st);
     float mn = fminf(md->sigma_a.c[0] + md->sigma_s.c[0], fminf(md->sigma_a.c[1] + md->sigma_s.c[1], md->sigma_a.c[2] + md->sigma_s.c[2]));
     if (st > 0 && mn / sm < 1e-2f)
@@ -363,6 +397,7 @@ int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen
             memset(nm, 0, sizeof *nm);
             return -1;
         }
+        murk_host_count_medium(&nm->m, nm->density->slot);
         s->nmedia++;
     }
     return 0;

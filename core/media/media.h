@@ -15,9 +15,9 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
                            char *err, size_t errlen);
 
 /* The keys every medium has, read by the core whatever the tracker (sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution), as a parameter schema; and the two keys read apart from it
+ * majorant_factor, majorant_resolution, majorant_repair), as a parameter schema; and the two keys read apart from it
  * ("density", "transmittance"). `murk plugins TRACKER` lists them. */
-#define MURK_MEDIUM_NCORE 6
+#define MURK_MEDIUM_NCORE 7
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
 extern const char *const murk_medium_special_keys[2];
 void murk_media_free(murk_scene *s);
@@ -30,6 +30,8 @@ void murk_density_parts(const murk_density *d, const struct murk_field **field, 
 float murk_media_density(const murk_density *d, murk_vec3 p);
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
+/* The calling thread's cost counters for d's medium (host.h): the host's counters() service. */
+murk_counters *murk_media_counters(const murk_density *d);
 void murk_warn_once(const char *fmt, ...) MURK_PRINTF(1, 2);
 /* Prints how often each once-only warning repeated, and forgets them. */
 void murk_warn_summary(void);

@@ -6,8 +6,12 @@
  *   control  float in [0, 10], default 1. The control density of a cell is control x the cell's
  *            minimum density (from the core's minorant grid). In [0, 1] the control never exceeds the
  *            local density, so every control collision is real and the residual is >= 0. Above 1 the
- *            control can exceed the density: the residual goes negative and murk switches to weighted
- *            residual collisions (unbiased, noisier) and says so once. 0 is plain delta tracking.
+ *            control can exceed the density; with `repair` it is clamped to 1 (said once at load).
+ *            0 is plain delta tracking.
+ *   repair   bool, default true. false keeps a control > 1: where a residual collision finds the control
+ *            above the density (negative residual) it is weighted (unbiased) and the rest of the flight
+ *            is tracked with the control lowered below the density seen (murk/tracking.h's per-flight
+ *            repair; noisier than the clamp) and murk says so once.
  *
  * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
  * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
@@ -18,17 +22,22 @@
  * history-aware over the channels' a_c (as in delta.c) and each channel is reweighted by a_c / q (real)
  * or (1 - a_c) / (1 - q) (null). A real collision scatters with weight albedo. The real-collision rate of
  * channel c is c sigma_min + (d(x) sigma_t,c - c sigma_min) = d(x) sigma_t,c: the expected image does not
- * depend on `control` — only noise and time do. Transmittance: the control part in closed form times
- * ratio tracking of the residual. Where the majorant fails to bound (majorant_factor < 1) or the control
- * exceeds the density, residual collisions are weighted (unbiased) and murk says so once. */
+ * depend on `control` — only noise and time do. Transmittance: the control part (never above the cell's
+ * minimum density) in closed form times ratio tracking of the residual. Where the majorant fails to bound (majorant_factor < 1 with
+ * majorant_repair: false) or the control exceeds the density (repair: false), the violating residual
+ * collision is weighted (unbiased), the rest of the flight raises the residual majorant or lowers the
+ * control, and murk says so once. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
-enum { P_CONTROL, P_COUNT };
+enum { P_CONTROL, P_REPAIR, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_CONTROL] = {"control", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 10,
                    "control density as a multiple of each majorant cell's minimum density (<= 1 stays below it)"},
+    [P_REPAIR] = {"repair", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
+                  "clamp the control to each cell's minimum density (control > 1 acts as 1); false: weighted "
+                  "residual collisions and a per-flight lower control where it exceeds the density"},
 };
 
 typedef struct decomposition {
@@ -45,12 +54,31 @@ static int decomposition_create(const murk_host *host, const murk_medium_data *d
     m->smin = murk_minf(m->base.sigma_t.c[0], murk_minf(m->base.sigma_t.c[1], m->base.sigma_t.c[2]));
     m->control = (float)p[P_CONTROL].f[0];
     m->base.plugin = "decomposition";
-    if (m->control > 1.0f)
+    if (m->control > 1.0f && p[P_REPAIR].f[0] != 0.0) {
         host->log(MURK_LOG_WARN,
-                  "medium '%s': decomposition control %g > 1 can exceed the local density (negative residual): "
-                  "residual collisions become weighted (unbiased, noisier)", data->name, m->control);
+                  "medium '%s': decomposition control %g > 1 would exceed the local density (each cell's control is "
+                  "control x its minimum density): murk clamps it to 1, the largest control that stays below the "
+                  "density everywhere (no bias, no extra noise; repair: false keeps it)", data->name, m->control);
+        m->control = 1.0f;
+    } else if (m->control > 1.0f) {
+        host->log(MURK_LOG_WARN,
+                  "medium '%s': decomposition control %g > 1 with repair: false can exceed the local density "
+                  "(negative residual): violating residual collisions are weighted and the flight's control "
+                  "lowered below the density seen (unbiased; noisier than repair: true)", data->name, m->control);
+    }
     *self = m;
     return 0;
+}
+
+/* A cell's two Poisson rates for this flight: control collisions rate_c = control x dmin x smin x cscale
+ * (real in every channel) and residual tentative collisions mu_r (>= |max extinction - rate_c|, x boost).
+ * cscale < 1 and boost > 1 are this flight's repairs where the control or the majorant failed. */
+static void decomposition_rates(const decomposition *m, float dmax, float dmin, float cscale, float boost,
+                                float *rate_c, float *mu_r)
+{
+    *rate_c = m->control * dmin * m->smin * cscale;
+    float r = dmax * m->base.smax - *rate_c;
+    *mu_r = murk_maxf(fabsf(r), 1e-3f * murk_maxf(dmax * m->base.smax, *rate_c)) * boost;
 }
 
 static void decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
@@ -63,9 +91,10 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
         return;
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
+    float ta, tb, dmax, dmin, cscale = 1.0f, boost = 1.0f;
     long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         if (++steps > MURK_WATCHDOG_ITERATIONS) {
@@ -73,9 +102,8 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             murk_event_kill(ev, ta);
             return;
         }
-        float rate_c = m->control * dmin * m->smin; /* control collisions: real in every channel */
-        float mu_r = dmax * m->base.smax - rate_c;
-        mu_r = murk_maxf(fabsf(mu_r), 1e-3f * murk_maxf(dmax * m->base.smax, rate_c));
+        float rate_c, mu_r;
+        decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
         float tc = rate_c > 0.0f ? murk_advance(ta, murk_sample_exp(rng, rate_c)) : INFINITY;
@@ -88,6 +116,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             float tr = mu_r > 0.0f ? murk_advance(t, murk_sample_exp(rng, mu_r)) : INFINITY;
             if (!(tc < tb) && !(tr < tb))
                 break;
+            count->collisions++; /* a control or a residual collision */
             if (tc <= tr) { /* control collision */
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= st.c[k] > 0.0f ? d->sigma_s.c[k] / st.c[k] : 0.0f;
@@ -104,10 +133,12 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
                 amax = murk_maxf(amax, a[k]);
             }
             if (amin < 0.0f)
-                h->warn_once("medium '%s': decomposition control exceeds the local density (negative residual): "
-                             "weighted residual collisions (unbiased, noisier)", d->name);
+                h->warn_once("medium '%s': decomposition control exceeds the local density (repair: false): "
+                             "decomposition tracking weights the violating residual collision and lowers the "
+                             "rest of the flight's control below the density seen (unbiased; noisier than "
+                             "repair: true)", d->name);
             if (amax > 1.0f)
-                murk_warn_majorant(&m->base, "decomposition tracking switches to weighted residual collisions");
+                murk_warn_majorant(&m->base, "decomposition tracking weights");
             float q = murk_collision_prob(&m->base, a, ctx, ev->weight);
             if (murk_rng_float(rng) < q) {
                 for (int k = 0; k < 3; k++)
@@ -119,6 +150,17 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             if (!m->base.grey || amin < 0.0f || amax > 1.0f)
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q);
+            if (amin < 0.0f || amax > 1.0f) {
+                /* the flight's repair (unbiased, murk/tracking.h): the rest of it, from t on, with the
+                 * control below the density seen here and the residual majorant above it; the pending
+                 * control distance is redrawn at the new rate (both processes are memoryless) */
+                if (amin < 0.0f)
+                    cscale *= murk_maxf(0.0f, dens * m->smin / (rate_c * MURK_MAJORANT_RAISE));
+                if (amax > 1.0f)
+                    boost = murk_minf(boost * MURK_MAJORANT_RAISE * amax, 1e12f);
+                decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
+                tc = rate_c > 0.0f ? murk_advance(t, murk_sample_exp(rng, rate_c)) : INFINITY;
+            }
         }
     }
 }
@@ -128,7 +170,10 @@ static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ra
 {
     (void)ctx;
     const decomposition *m = self;
-    return murk_ratio_tracking(m->base.host, m->base.d, ray, m->control, rng);
+    /* shadow rays always with the control clamped to the cell's minimum density: a control above the density
+     * makes the closed-form part overshoot by exp(-(c - density) sigma L), which ratio tracking must undo
+     * with weights that grow like exp(+...) — unbiased but heavy-tailed (|z| 17 at control 10, docs/stability.md) */
+    return murk_ratio_tracking(m->base.host, m->base.d, ray, murk_minf(m->control, 1.0f), rng);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, decomposition_create,

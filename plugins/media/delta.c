@@ -12,8 +12,9 @@
  * path's weight so far (history-aware, after Kutz et al. 2017, which keeps the weights bounded where a
  * plain channel average lets them grow without limit), and every channel is reweighted (real:
  * sigma_s,c(x) / (mu q), null: (mu - sigma_t,c(x)) / (mu (1 - q))) — unbiased; murk says so once. Where
- * the majorant fails to bound (majorant_factor < 1), the same weighted choice keeps the estimate
- * unbiased and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance: the
+ * the majorant fails to bound (majorant_factor < 1 with majorant_repair: false), the same weighted choice
+ * keeps the violating collision unbiased, the rest of the flight is tracked with the majorant raised
+ * (murk_collisions_raise), and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance: the
  * minorant grid as control) with Russian roulette on small
  * transmittance. */
 #include "murk/medium.h"
@@ -52,7 +53,7 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
             amax = murk_maxf(amax, a[k]);
         }
         if (amax > 1.0f)
-            murk_warn_majorant(m, "delta tracking switches to weighted collisions");
+            murk_warn_majorant(m, "delta tracking weights");
         float q = murk_collision_prob(m, a, ctx, ev->weight);
         if (murk_rng_float(rng) < q) {
             for (int k = 0; k < 3; k++) /* sigma_s,k(x) / (mu q): the albedo for grey extinction */
@@ -64,6 +65,7 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
         if (!m->grey || amax > 1.0f)
             for (int k = 0; k < 3; k++)
                 ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q);
+        murk_collisions_raise(&c, amax);
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);

@@ -8,8 +8,9 @@
  * real with probability sigma_t,h(x) / mu_h and scatters with weight albedo_h. The other channels get
  * weight 0 and pdf ratio 0 (murk/medium.h), so the integrator credits the hero channel with 3x its
  * estimate: unbiased per channel, but every path carries one channel — the colour noise that spectral
- * tracking and spectral MIS remove. Where the majorant fails to bound, weighted collisions keep it
- * unbiased and murk says so once. Shadow rays use residual ratio tracking (every channel is estimated; only the
+ * tracking and spectral MIS remove. Where the majorant fails to bound, a weighted collision keeps it
+ * unbiased, the rest of the flight is tracked with the majorant raised (murk_collisions_raise) and murk
+ * says so once. Shadow rays use residual ratio tracking (every channel is estimated; only the
  * hero's carries weight in the path). */
 #include "murk/medium.h"
 #include "murk/tracking.h"
@@ -42,7 +43,7 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a = dens * st / c.mu;
         if (a > 1.0f)
-            murk_warn_majorant(m, "per-channel delta tracking uses weighted collisions");
+            murk_warn_majorant(m, "per-channel delta tracking weights");
         float q = murk_real_prob(a, 1.0f - a);
         if (murk_rng_float(rng) < q) {
             ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (c.mu * q);
@@ -52,6 +53,7 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
         }
         if (a > 1.0f)
             ev->weight.c[hero] *= (1.0f - a) / (1.0f - q);
+        murk_collisions_raise(&c, a);
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);

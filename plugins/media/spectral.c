@@ -14,7 +14,8 @@
  * the path (weight 0), a scattering event weights channel c by sigma_s,c / (mu P_s), a null event by
  * sigma_n,c / (mu P_n). Unbiased for any choice of probabilities that is non-zero wherever the
  * coefficient is; where the majorant fails to bound (sigma_n < 0) the absolute values keep it so, with
- * negative weights, and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
+ * negative weights, the rest of the flight is tracked with the majorant raised (murk_collisions_raise),
+ * and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -74,7 +75,7 @@ static void spectral_sample(const void *self, const murk_ray *ray, const murk_pa
             hist[k] = ctx->beta.c[k] * ev->weight.c[k];
         }
         if (neg)
-            murk_warn_majorant(&m->base, "spectral tracking uses negative null weights");
+            murk_warn_majorant(&m->base, "spectral tracking gives negative null weights to");
         float pa = pick(m->scheme, sa, hist), ps = pick(m->scheme, ss, hist), pn = pick(m->scheme, sn, hist);
         float sum = pa + ps + pn, u = murk_rng_float(rng) * sum;
         if (!(sum > 0.0f) || u < pa) { /* absorbed (or no weight left in any channel): the path ends */
@@ -90,8 +91,12 @@ static void spectral_sample(const void *self, const murk_ray *ray, const murk_pa
             ev->t = t;
             return;
         }
-        for (int k = 0; k < 3; k++)
+        float amax = 0.0f;
+        for (int k = 0; k < 3; k++) {
             ev->weight.c[k] *= sn[k] * sum / (c.mu * pn);
+            amax = murk_maxf(amax, (sa[k] + ss[k]) / c.mu);
+        }
+        murk_collisions_raise(&c, amax);
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);

@@ -14,8 +14,9 @@
  * of pdf ratios: the balance heuristic over channels, applied to the whole path (not per segment),
  * together with NEE. A channel whose extinction differs wildly from the hero's no longer blows up the
  * weights as in per-channel delta tracking: some hero samples it well. Where the majorant fails to
- * bound, q_k = |a| / (|a| + |1 - a|) keeps every technique valid (weighted, unbiased) and murk says so
- * once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
+ * bound, q_k = |a| / (|a| + |1 - a|) keeps every technique valid (weighted, unbiased), the rest of the
+ * flight is tracked with the majorant raised (murk_collisions_raise: the same raise for every channel's
+ * technique, so the distance pdfs stay equal) and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -41,13 +42,14 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
     murk_collisions_init(&c, m, ray, m->smax); /* one majorant for every channel */
     float t, dens;
     while (murk_collisions_next(&c, rng, &t, &dens)) {
-        float a[3], q[3];
+        float a[3], q[3], amax = 0.0f;
         for (int k = 0; k < 3; k++) {
             a[k] = dens * m->sigma_t.c[k] / c.mu;
             q[k] = murk_real_prob(a[k], 1.0f - a[k]);
+            amax = murk_maxf(amax, a[k]);
         }
-        if (a[hero] > 1.0f)
-            murk_warn_majorant(m, "spectral MIS uses weighted collisions");
+        if (amax > 1.0f)
+            murk_warn_majorant(m, "spectral MIS weights");
         if (murk_rng_float(rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
                 ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
@@ -61,6 +63,7 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
             ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
             ev->pdf_ratio.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
         }
+        murk_collisions_raise(&c, amax);
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);

@@ -5,7 +5,13 @@
  * estimators, murk/transmittance.h). Header-only; include after murk/medium.h.
  *
  * A tracker that walks the majorant grid itself (host->walk_init / walk_next) and reads the density
- * with host->density() needs nothing else from here; these helpers are what murk's own trackers share. */
+ * with host->density() needs nothing else from here; these helpers are what murk's own trackers share.
+ *
+ * Cost counters (murk/counters.h). The core counts density lookups and majorant cells inside
+ * host->density() and host->walk_next(), so a tracker that walks the grid itself has its lookups and
+ * cells counted with nothing to do; the helpers below count their tentative collisions. A tracker that
+ * draws its own collisions takes murk_tracker_counters() once per flight and adds one to ->collisions
+ * per tentative (null or real) collision (decomposition.c does). */
 #ifndef MURK_TRACKING_H
 #define MURK_TRACKING_H
 
@@ -50,6 +56,14 @@ static inline void murk_tracker_free(void *self)
     murk_tracker *t = self;
     if (t)
         t->host->free(t);
+}
+
+/* The calling thread's counters for medium d (host->counters, once per flight), or *scratch when the
+ * host predates ABI 1.4 or fills no counters (a test's host table): never NULL. */
+static inline murk_counters *murk_tracker_counters(const murk_host *h, const murk_medium_data *d,
+                                                   murk_counters *scratch)
+{
+    return MURK_HAS(h->size, murk_host, counters) && h->counters ? h->counters(d->density) : scratch;
 }
 
 /* An event that passes the whole segment with weight 1 and pdf ratios 1. */
@@ -123,23 +137,48 @@ static inline float murk_collision_prob(const murk_tracker *t, const float a[3],
     return pr + pn > 0.0f ? pr / (pr + pn) : 0.5f;
 }
 
+/* Where a majorant or control is wrong (docs/stability.md).
+ *
+ * The core repairs a majorant_factor < 1 before rendering (majorant_repair, the default: every cell gets
+ * its exact bound back) and decomposition clamps its control to each cell's minimum density (its `repair`
+ * parameter), so by default no tracker sees a violation. With the repairs off (or for a tracker of
+ * its own whose bounds are estimated) a tracker may meet a tentative collision whose real share a > 1
+ * (density above the majorant) or < 0 (control above the density). It weights that collision as
+ * murk_real_prob says — a factor up to |a| + |1 - a| on the path's weight — and then raises the majorant
+ * of the rest of the FLIGHT by MURK_MAJORANT_RAISE x a (murk_collisions_raise), in this cell and the
+ * following ones. That is unbiased: the null-collision identity holds for any majorant along the
+ * remaining segment, and the remaining segment is estimated afresh after each collision, so the
+ * majorant after a collision may depend on everything sampled before it. It is per path, from the
+ * path's own random numbers: the image stays a pure function of (scene, seed, spp) for any thread
+ * count and tiling, which a majorant shared and raised between threads at run time would break. Without
+ * the raise a weight of 2a - 1 multiplies at EVERY violating collision (relMSE 1e19 on cornell_smoke at
+ * majorant_factor 0.5); with it about one collision per flight is weighted. Each flight starts again
+ * from the grid's majorant (a path has no state of its own), which is why the core's repair, not this
+ * one, is the default. */
+#define MURK_MAJORANT_RAISE 2.0f
+
 /* The warning for a density above the majorant (a real share above 1), once per run and medium;
- * `what` says how the tracker copes, e.g. "delta tracking switches to weighted collisions". */
+ * `what` names the tracker's way to weight the collision, e.g. "delta tracking weights". */
 static inline void murk_warn_majorant(const murk_tracker *t, const char *what)
 {
-    t->host->warn_once("medium '%s': density exceeds the majorant (majorant_factor < 1?): %s (unbiased, noisier)",
-                       t->d->name, what);
+    t->host->warn_once("medium '%s': density above the majorant (majorant_repair: false?): %s the violating "
+                       "collision and raises the rest of the flight's majorant %gx the excess (unbiased; more "
+                       "tentative collisions, noisier than the repaired majorant)", t->d->name, what,
+                       (double)MURK_MAJORANT_RAISE);
 }
 
 /* Tentative collisions along a ray: a Poisson process whose rate in each majorant cell is
- * mu = (the cell's maximum density) x sigma, walked cell by cell (delta tracking's proposal). */
+ * mu = (the cell's maximum density) x sigma x boost, walked cell by cell (delta tracking's proposal);
+ * boost starts at 1 and only murk_collisions_raise changes it. */
 typedef struct murk_collisions {
     const murk_tracker *tr;
     const murk_ray *ray;
     murk_majorant_walk walk;
     float sigma, t, tb, mu, dmin;
+    float boost; /* this flight's majorant multiplier, raised where the majorant failed */
     long steps;  /* collisions and cells so far */
     int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
+    murk_counters *count, scratch; /* the medium's cost counters (murk_tracker_counters) */
 } murk_collisions;
 
 static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *tr, const murk_ray *ray, float sigma)
@@ -150,9 +189,23 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->t = c->tb = ray->tmin;
     c->mu = 0.0f;
     c->dmin = 0.0f;
+    c->boost = 1.0f;
     c->steps = 0;
     c->stopped = 0;
+    c->count = murk_tracker_counters(tr->host, tr->d, &c->scratch);
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
+}
+
+/* After a tentative collision whose largest real share was amax > 1: the rest of this flight is drawn
+ * with the majorant raised by MURK_MAJORANT_RAISE x amax (unbiased, see above). Call it after the
+ * collision's real/null choice and weights, never before. */
+static inline void murk_collisions_raise(murk_collisions *c, float amax)
+{
+    if (!(amax > 1.0f))
+        return;
+    float f = fminf(MURK_MAJORANT_RAISE * amax, 1e6f);
+    c->boost = fminf(c->boost * f, 1e12f);
+    c->mu *= f;
 }
 
 /* The next tentative collision: its distance *t and the density *dens there; c->mu is the majorant rate
@@ -170,6 +223,7 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
         if (c->mu > 0.0f) {
             c->t = murk_advance(c->t, murk_sample_exp(rng, c->mu));
             if (c->t < c->tb) {
+                c->count->collisions++;
                 *t = c->t;
                 *dens = c->tr->host->density(c->tr->d->density, murk_madd(c->ray->o, c->ray->d, c->t));
                 return 1;
@@ -179,7 +233,7 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
         if (!c->tr->host->walk_next(&c->walk, &ta, &c->tb, &dmax, &c->dmin))
             return 0;
         c->t = ta;
-        c->mu = dmax * c->sigma;
+        c->mu = dmax * c->sigma * c->boost;
     }
 }
 
@@ -195,9 +249,10 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
     float smax = murk_rgb_max(st);
     if (!(smax > 0.0f))
         return T;
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
-    float ta, tb, dmax, dmin;
+    float ta, tb, dmax, dmin, boost = 1.0f; /* boost: the ray's majorant raise where it failed */
     long steps = 0;
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         float c = control * dmin; /* control density, handled in closed form */
@@ -209,18 +264,25 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
                 T.c[k] *= expf(-c * st.c[k] * len);
         }
         /* residual majorant; any positive value keeps ratio tracking unbiased, so a control above the
-         * majorant only costs variance */
-        float mu = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * smax;
+         * majorant only costs variance; where |density - control| x sigma exceeds it the rest of the ray
+         * is tracked with it raised (unbiased for the reason given above murk_collisions_raise) */
+        float mu = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * smax * boost;
         if (!(mu > 0.0f))
             continue;
         for (float t = ta;;) {
             t = murk_advance(t, murk_sample_exp(rng, mu));
             if (!(t < tb))
                 break;
+            count->collisions++;
             murk_vec3 p = murk_madd(ray->o, ray->d, t);
-            float dens = h->density(d->density, p) - c;
+            float dens = h->density(d->density, p) - c, r = fabsf(dens) * smax / mu;
             for (int k = 0; k < 3; k++)
                 T.c[k] *= 1.0f - dens * st.c[k] / mu;
+            if (r > 1.0f) { /* the majorant failed (|factor| may exceed 1): raise it for the rest of the ray */
+                float f = fminf(MURK_MAJORANT_RAISE * r, 1e6f);
+                boost = fminf(boost * f, 1e12f);
+                mu *= f;
+            }
             float tm = fmaxf(fabsf(T.c[0]), fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
             if (tm < 0.1f) {
                 if (tm <= 0.0f || murk_rng_float(rng) >= tm)
