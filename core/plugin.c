@@ -66,6 +66,24 @@ static int running_uninstalled(void)
     return strncmp(exe, root, rl) == 0 && exe[rl] == '/';
 }
 
+/* The plugin folder of the libmurk this code runs in: DIR/murk/plugins for DIR/libmurk.so, so that an
+ * install that was moved, or staged with DESTDIR, finds its own built-in plugins (MURK_PLUGINDIR, the
+ * configured prefix's folder, is only the fallback). 0, or -1 if the library's file is unknown. */
+static int plugindir_beside_libmurk(char *out, size_t n)
+{
+    static const char anchor = 0; /* an address inside libmurk */
+    Dl_info info;
+    char lib[PATH_MAX];
+    if (!dladdr(&anchor, &info) || !info.dli_fname || !realpath(info.dli_fname, lib))
+        return -1;
+    char *slash = strrchr(lib, '/');
+    if (!slash)
+        return -1;
+    *slash = 0;
+    int k = snprintf(out, n, "%s/murk/plugins", lib);
+    return k > 0 && (size_t)k < n ? 0 : -1;
+}
+
 void murk_registry_init(murk_registry *r)
 {
     memset(r, 0, sizeof *r);
@@ -79,8 +97,14 @@ void murk_registry_init(murk_registry *r)
             p = c + 1;
         }
     }
-    const char *d = running_uninstalled() ? MURK_BUILD_PLUGINDIR : MURK_PLUGINDIR;
-    add_dir(r, d, strlen(d));
+    if (running_uninstalled()) {
+        add_dir(r, MURK_BUILD_PLUGINDIR, strlen(MURK_BUILD_PLUGINDIR));
+        return;
+    }
+    char beside[PATH_MAX];
+    if (plugindir_beside_libmurk(beside, sizeof beside) == 0)
+        add_dir(r, beside, strlen(beside));
+    add_dir(r, MURK_PLUGINDIR, strlen(MURK_PLUGINDIR));
 }
 
 void murk_plugin_close(murk_plugin *p)

@@ -21,7 +21,8 @@ typedef struct murk_registry {
 } murk_registry;
 
 /* Search path: $MURK_PLUGIN_PATH (':'-separated, empty entries ignored), then the build's plugin folder
- * when this murk runs from its build tree, else the installed plugin folder. Never the current folder
+ * when this murk runs from its build tree, else the murk/plugins folder beside the libmurk.so in use
+ * (a moved or DESTDIR-staged install finds its own), then the configured one. Never the current folder
  * unless a MURK_PLUGIN_PATH entry names it. */
 void murk_registry_init(murk_registry *r);
 void murk_registry_free(murk_registry *r); /* dlcloses everything it opened */

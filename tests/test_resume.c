@@ -290,10 +290,75 @@ static void test_resume_refuses(void **state)
     free(out);
 }
 
+/* The checkpoint's content hash covers the files the scene loads: after the scene's mesh, density grid
+ * or texture changed, --resume is refused; unchanged, it resumes. */
+static void test_resume_refuses_changed_inputs(void **state)
+{
+    (void)state;
+    const char *dir = make_dir("inputs");
+    char path[4096], ck[4096], exr[4096], grid[4096];
+    snprintf(grid, sizeof grid, "%s/g.vol", dir);
+    char *out = NULL;
+    assert_int_equal(run_murk(&out, "grid", grid, "--res", "8", NULL), 0);
+    free(out);
+    char tex[4096]; /* a texture: the PNG preview of a tiny render */
+    snprintf(tex, sizeof tex, "%s/tex.exr", dir);
+    assert_int_equal(run_murk(&out, "render", scene_path(), "-o", tex, "--spp", "1", "--quiet", "--set",
+                              "render.resolution=[4,4]", NULL), 0);
+    free(out);
+    snprintf(path, sizeof path, "%s/m.obj", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n", f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/s.yaml", dir);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("murk: 1\nrender: { resolution: [8, 8], spp: 4 }\nintegrator: { type: volpath_nee }\n"
+          "materials: { w: { type: diffuse, albedo: { texture: image, file: tex.png } } }\n"
+          "media: { g: { type: delta, density: { grid: g.vol } } }\n"
+          "shapes:\n"
+          "  - { type: mesh, file: m.obj, material: w, emission: 1 }\n"
+          "  - { type: box, min: [-0.5, -0.5, -0.5], max: [0.5, 0.5, 0.5], interior: g }\n", f);
+    fclose(f);
+    snprintf(ck, sizeof ck, "%s/ck", dir);
+    snprintf(exr, sizeof exr, "%s/a.exr", dir);
+    /* each step: a fresh 2-spp checkpoint, one input changed (the mesh by a comment: the content is what
+     * counts; the grid baked with another seed; the texture rendered with another seed), --resume */
+    char obj[4096];
+    snprintf(obj, sizeof obj, "%s/m.obj", dir);
+    for (int step = 0; step < 4; step++) {
+        assert_int_equal(run_murk(&out, "render", path, "-o", exr, "--spp", "2", "--checkpoint", ck, "--quiet", NULL), 0);
+        free(out);
+        if (step == 1) {
+            f = fopen(obj, "a");
+            assert_non_null(f);
+            fputs("# edited\n", f);
+            fclose(f);
+        } else if (step == 2) {
+            assert_int_equal(run_murk(&out, "grid", grid, "--res", "8", "--seed", "2", NULL), 0);
+            free(out);
+        } else if (step == 3) {
+            assert_int_equal(run_murk(&out, "render", scene_path(), "-o", tex, "--spp", "1", "--quiet", "--set",
+                                      "render.resolution=[4,4]", "--set", "render.seed=9", NULL), 0);
+            free(out);
+        }
+        int rc = run_murk(&out, "render", path, "-o", exr, "--resume", ck, "--quiet", NULL);
+        if (step == 0) /* unchanged: resumes */
+            assert_int_equal(rc, 0);
+        else {
+            assert_int_equal(rc, 1);
+            assert_contains(out, "a file it loads (mesh, grid, texture) changed since");
+        }
+        free(out);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resume_refuses),
+        cmocka_unit_test(test_resume_refuses_changed_inputs),
         cmocka_unit_test(test_interrupted_image),
         cmocka_unit_test(test_kill_resume_bitwise),
     };

@@ -1,7 +1,9 @@
 #!/bin/sh
 # test_sdk.sh — the plugin author's path of docs/plugins.md, end to end, against an INSTALLED murk:
 #   1. `meson install --destdir` this build into a fresh temporary folder;
-#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0);
+#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0) and, with no
+#      MURK_PLUGIN_PATH, finds and renders with its built-in plugins (the murk/plugins folder beside
+#      the installed libmurk, though the install is staged away from its prefix);
 #   3. copy the installed share/murk/examples, build them out of tree with their own meson.build and
 #      the installed murk-plugin.pc (PKG_CONFIG_PATH into the temporary prefix);
 #   4. the installed murk lists them (MURK_PLUGIN_PATH), `murk check`s each one, and renders a scene
@@ -33,6 +35,17 @@ BUILTINS=$(dirname "$BUILTINS")
 step "the installed murk finds libmurk through its RPATH"
 readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
 env -u LD_LIBRARY_PATH "$MURK" --version || fail "installed murk does not start (RPATH?)"
+
+step "the installed murk finds its built-in plugins beside its libmurk (no MURK_PLUGIN_PATH)"
+# the install is staged under a destdir, not at its configured prefix: only a search relative to the
+# installed libmurk can find them
+env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" plugins diffuse >"$TMP/builtin.txt" 2>&1 ||
+  { cat "$TMP/builtin.txt"; fail "the installed murk does not find the built-in diffuse"; }
+grep -qF "file: $(realpath "$BUILTINS")/diffuse.so" "$TMP/builtin.txt" ||
+  { cat "$TMP/builtin.txt"; fail "diffuse.so was not taken from the installed plugin folder $BUILTINS"; }
+env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "${MURK_SOURCE_ROOT:?}/scenes/cornell_smoke.yaml" \
+  -o "$TMP/builtin.exr" --spp 1 --set 'render.resolution=[16,16]' --quiet || fail "the installed murk does not render"
+[ -s "$TMP/builtin.exr" ] || fail "the installed murk wrote no image"
 
 step "murk-plugin.pc: headers, -lm, hidden visibility, no -lmurk"
 export PKG_CONFIG_PATH="$(dirname "$PCFILE")"

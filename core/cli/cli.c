@@ -475,7 +475,7 @@ static int render_main(int argc, char **argv)
     if (opts.parts)
         snprintf(parttag, sizeof parttag, "%d/%d", opts.part, opts.parts);
     if (opts.checkpoint || opts.resume || opts.parts || mpi_run.size > 1) {
-        opts.scene_hash = murk_file_hash(scene_path, err, sizeof err);
+        opts.scene_hash = murk_scene_hash(s, err, sizeof err); /* the YAML and every file it loads */
         /* a part's checkpoint is no other part's, nor the whole image's */
         snprintf(ckid, sizeof ckid, "%s%s%s", setbuf, opts.parts ? " --part " : "", parttag);
         opts.overrides = ckid;

@@ -119,7 +119,8 @@ int murk_ckpt_load(const char *path, const murk_ckpt *want, murk_ckpt *c, char *
     }
     const char *wo = want->overrides ? want->overrides : "";
     if (c->scene_hash != want->scene_hash) {
-        murk_err_file(err, errlen, path, "checkpoint of another scene (content hash %016llx, this scene is %016llx)",
+        murk_err_file(err, errlen, path, "checkpoint of another scene, or the scene file or a file it loads (mesh, "
+                      "grid, texture) changed since (content hash %016llx, now %016llx)",
                       (unsigned long long)c->scene_hash, (unsigned long long)want->scene_hash);
         goto out;
     }

@@ -6,6 +6,7 @@
  * "file:line:col: what is wrong". */
 #include "scene.h"
 #include "accel.h"
+#include "checkpoint.h"
 #include "host.h"
 #include "limit.h"
 #include "media.h"
@@ -575,6 +576,53 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
     murk_vec3 lo, hi;
     scene_bounds(s, &lo, &hi);
     return murk_media_check_depth(s, murk_ymap_get(root, "media"), lo, hi, err, errlen);
+}
+
+/* ---- The scene's content hash ---------------------------------------------------------------- */
+
+/* Folds one input file into h: its path as the scene names it and its content. -1 with err if it
+ * cannot be read (the loader read it a moment ago: it changed under us). */
+static int hash_input(const murk_scene *s, const murk_ynode *file, uint64_t *h, char *err, size_t errlen)
+{
+    if (!file || file->kind != MURK_Y_SCALAR || !*file->str)
+        return 0;
+    char *path = murk_path_relative_to(s->doc.file, file->str);
+    uint64_t fh = murk_file_hash(path, err, errlen);
+    *h = murk_fnv1a(*h, path, strlen(path) + 1);
+    *h = murk_fnv1a(*h, &fh, sizeof fh);
+    free(path);
+    return fh ? 0 : -1;
+}
+
+/* Every image texture's file under n ({ texture: image, file: F, ... } anywhere in a block). */
+static int hash_textures(const murk_scene *s, const murk_ynode *n, uint64_t *h, char *err, size_t errlen)
+{
+    if (!n || n->kind == MURK_Y_SCALAR)
+        return 0;
+    const murk_ynode *t = murk_ymap_get(n, "texture");
+    if (t && t->kind == MURK_Y_SCALAR && !strcmp(t->str, "image") && hash_input(s, murk_ymap_get(n, "file"), h, err, errlen))
+        return -1;
+    for (size_t i = 0; i < n->n; i++)
+        if (hash_textures(s, n->items[i], h, err, errlen))
+            return -1;
+    return 0;
+}
+
+MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
+{
+    uint64_t h = murk_file_hash(s->doc.file, err, errlen);
+    if (!h)
+        return 0;
+    const murk_ynode *root = s->doc.root, *shapes = murk_ymap_get(root, "shapes"), *media = murk_ymap_get(root, "media");
+    for (size_t i = 0; shapes && shapes->kind == MURK_Y_SEQ && i < shapes->n; i++) /* meshes */
+        if (names(shapes->items[i], "type", "mesh") && hash_input(s, murk_ymap_get(shapes->items[i], "file"), &h, err, errlen))
+            return 0;
+    for (size_t i = 0; media && i < media->n; i++) /* density grids */
+        if (hash_input(s, murk_ymap_get(murk_ymap_get(media->items[i], "density"), "grid"), &h, err, errlen))
+            return 0;
+    if (hash_textures(s, root, &h, err, errlen))
+        return 0;
+    return h ? h : 1;
 }
 
 MURK_API int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen)

@@ -214,9 +214,13 @@ int murk_scene_instantiate(murk_scene *s, int kind, const murk_ynode *type_node,
         break;
     default: rc = -1; snprintf(cerr, sizeof cerr, "unknown plugin kind %d", kind);
     }
-    if (rc != 0) {
+    if (rc != 0) { /* a refusal of values a --set gave is the --set's: quote the last one */
+        const murk_ynode *at = map;
+        for (size_t i = 0; map->kind == MURK_Y_MAP && i < map->n; i++)
+            if (murk_yfrom_set(map->items[i]->file))
+                at = map->items[i];
         *self = NULL;
-        return ERR(map, "%s: %s", who, cerr[0] ? cerr : "create() failed");
+        return ERR(at, "%s: %s", who, cerr[0] ? cerr : "create() failed");
     }
     *plugin = p;
     return 0;

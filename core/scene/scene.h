@@ -102,6 +102,11 @@ struct murk_scene {
  * them directly. Returns 0, or -1 with err. */
 int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
 
+/* The content hash a checkpoint carries: the scene file and every file it loads (meshes, density
+ * grids, image textures, as named after the --set overrides), each with its path; so a resume after
+ * any of them changed is refused. 0 with err if one cannot be read. */
+uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
+
 /* Releases what a shape owns (its triangle arrays). */
 void murk_shape_free(murk_shape *sh);
 
