@@ -30,6 +30,7 @@ static const char *join(const char *root, const char *rel)
 
 const char *src_path(const char *rel) { return join(env_or("MURK_SOURCE_ROOT", "."), rel); }
 const char *build_path(const char *rel) { return join(env_or("MURK_BUILD_ROOT", "build"), rel); }
+const char *tmp_path(const char *name) { return join(tmp_dir(), name); }
 
 const char *tmp_dir(void)
 {
@@ -78,7 +79,11 @@ int run_murk_argv(char **out, const char *const *args)
     for (; *args && argc < 95; args++)
         argv[argc++] = *args;
     argv[argc] = NULL;
+    return run_argv(out, argv);
+}
 
+int run_argv(char **out, const char *const *argv)
+{
     char logpath[512];
     snprintf(logpath, sizeof logpath, "%s/run-%d.log", tmp_dir(), (int)getpid());
     pid_t pid = fork();
@@ -235,4 +240,21 @@ int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, i
     printf("  %-44s max |z| %.2f (block %d,%d ch %d), mean z %+.3f over %d blocks (bound %.3f), block se %.2f%%: %s\n",
            label, zmax, zmax_x, zmax_y, zmax_c, zmean, nblocks, bound, 100.0 * rel / sum_ref, ok ? "agree" : "DIFFER");
     return ok;
+}
+
+void assert_same_pixels(const char *a, const char *b)
+{
+    murk_image A = {0}, B = {0};
+    char err[1024];
+    if (murk_exr_read(a, &A, err, sizeof err) != 0 || murk_exr_read(b, &B, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    if (A.w != B.w || A.h != B.h)
+        fail_msg("%s is %dx%d, %s is %dx%d", a, A.w, A.h, b, B.w, B.h);
+    size_t n = 3 * (size_t)A.w * (size_t)A.h;
+    for (size_t i = 0; i < n; i++)
+        if (memcmp(&A.rgb[i], &B.rgb[i], sizeof(float)) != 0)
+            fail_msg("%s and %s differ first at pixel (%zu, %zu) channel %zu: %.9g vs %.9g", a, b,
+                     i / 3 % (size_t)A.w, i / 3 / (size_t)A.w, i % 3, A.rgb[i], B.rgb[i]);
+    murk_image_free(&A);
+    murk_image_free(&B);
 }

@@ -32,11 +32,18 @@ const char *build_path(const char *rel);
 int run_murk(char **out, const char *arg0, ...);
 /* A fresh temporary directory for this test program (created once, removed by the OS's tmp cleaning). */
 const char *tmp_dir(void);
+/* tmp_dir()/name (static buffer rotated 8 ways with src_path's and build_path's). */
+const char *tmp_path(const char *name);
 /* Writes text to tmp_dir()/name and returns its path. */
 const char *write_tmp(const char *name, const char *text);
 
 /* The same with the arguments in a NULL-terminated array. */
 int run_murk_argv(char **out, const char *const *args);
+/* The same for any program: argv[0] is its path (e.g. mpirun's, with murk's among the arguments). */
+int run_argv(char **out, const char *const *argv);
+
+/* Fails the test unless the EXRs a and b hold bitwise the same pixels (their attributes may differ). */
+void assert_same_pixels(const char *a, const char *b);
 
 /* A scene rendered with several seeds: per pixel and channel (r, g, b, and their average in channel
  * 3) the mean over the renders and the variance of that mean (sample variance over the seeds / n). */

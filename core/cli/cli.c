@@ -12,6 +12,7 @@
 #include "image.h"
 #include "limit.h"
 #include "media.h"
+#include "mpi_job.h"
 #include "plugin_loader.h"
 #include "scene.h"
 #include "util.h"
@@ -29,16 +30,19 @@
 static const char usage_text[] =
     "usage:\n"
     "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
-    "              [--checkpoint FILE [--every S]] [--resume FILE]\n"
+    "              [--checkpoint FILE [--every S]] [--resume FILE] [--part I/N]\n"
+    "  mpirun -n N murk render ...          (one image over N processes)\n"
+    "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
     "  murk plugins [NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--diff DIFF.png]\n"
+    "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
     "  murk --version\n";
 
 /* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
  * eight rotating buffers, so one message may quote several. */
-static const char *q(const char *s)
+const char *murk_cli_q(const char *s)
 {
     static char buf[8][1024];
     static int k;
@@ -46,11 +50,15 @@ static const char *q(const char *s)
     return murk_printable(buf[k], sizeof buf[k], s);
 }
 
+#define q(s) murk_cli_q(s)
+#define cli_error(m) murk_cli_error(m)
+#define usage(m) murk_cli_usage(m)
+
 /* "murk: MESSAGE" for a message built from input (the scene's and loaders' errors are printable
  * already; plugin and image errors may quote a raw argument). */
-static void cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", q(msg)); }
+void murk_cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", murk_cli_q(msg)); }
 
-static int usage(const char *msg)
+int murk_cli_usage(const char *msg)
 {
     if (msg)
         fprintf(stderr, "murk: %s\n", msg);
@@ -127,7 +135,130 @@ static void catch_stop_signals(void)
     sigaction(SIGTERM, &sa, NULL);
 }
 
+/* ---- render under MPI -------------------------------------------------------------------------
+ * Every rank runs cmd_render. Until the scene is loaded, the ranks other than 0 write their messages
+ * into a temporary file instead of stderr (the same warnings as rank 0's, once per rank, are noise).
+ * Then all agree (murk_mpi_agree) that each loaded the same scene, --set and options (rank 0's
+ * fingerprint) — or, if any failed, rank 0 prints the first failure's message naming its rank and
+ * host, and every rank exits 1 before rendering. A rank that fails before that point agrees in
+ * mpi_render's epilogue instead. Only rank 0 writes files and prints the summary; every rank exits
+ * with rank 0's status. */
+static struct {
+    int size, rank, agreed, saved_fd;
+    FILE *capture;
+} mpi_run = {1, 0, 0, -1, NULL};
+
+/* Stops capturing a rank's messages; the text captured (at most n - 1 bytes) into buf, if buf. */
+static void mpi_uncapture(char *buf, size_t n)
+{
+    if (buf && n)
+        buf[0] = 0;
+    if (!mpi_run.capture)
+        return;
+    fflush(stderr);
+    if (buf && n) {
+        rewind(mpi_run.capture);
+        size_t k = fread(buf, 1, n - 1, mpi_run.capture);
+        buf[k] = 0;
+    }
+    dup2(mpi_run.saved_fd, STDERR_FILENO);
+    close(mpi_run.saved_fd);
+    fclose(mpi_run.capture);
+    mpi_run.capture = NULL;
+}
+
+/* Collective, once per rank: 0 when every rank is fine and was given what rank 0 was (fingerprint),
+ * else 1 after rank 0 printed the first failure. */
+static int mpi_agree(int ok, const char *fingerprint, const char *why)
+{
+    char msg[4096], fp0[4096];
+    int who;
+    mpi_run.agreed = 1;
+    mpi_uncapture(ok ? NULL : msg, sizeof msg);
+    if (ok) {
+        snprintf(fp0, sizeof fp0, "%s", fingerprint);
+        murk_mpi_bcast(fp0, sizeof fp0);
+        if (strcmp(fp0, fingerprint) != 0) {
+            ok = 0;
+            snprintf(msg, sizeof msg, "murk: rank %d (%s) was given another scene file or other options than rank "
+                     "0 (%.1900s, not %.1900s)\n", mpi_run.rank, murk_mpi_host(), fingerprint, fp0);
+        }
+    } else {
+        murk_mpi_bcast(fp0, sizeof fp0); /* matches the fine ranks' broadcast */
+        if (why)
+            snprintf(msg, sizeof msg, "%s", why);
+    }
+    if (!ok) { /* rank 0 prints it, naming where it happened */
+        size_t l = strlen(msg);
+        snprintf(msg + l, sizeof msg - l, "%smurk: (the error of rank %d of %d, on host %s)\n",
+                 l && msg[l - 1] != '\n' ? "\n" : "", mpi_run.rank, mpi_run.size, murk_mpi_host());
+    }
+    int bad = murk_mpi_agree(ok, msg, sizeof msg, &who);
+    if (bad && mpi_run.rank == 0 && who > 0)
+        fprintf(stderr, "%s%s", msg, bad > 1 ? "murk: (other ranks failed too)\n" : "");
+    return bad != 0;
+}
+
+static int render_main(int argc, char **argv);
+
+/* cmd_render under mpirun; a process started without a launcher (or a build without MPI) renders alone. */
 static int cmd_render(int argc, char **argv)
+{
+    char err[256] = "";
+    if (murk_mpi_launched() && !murk_mpi_built()) {
+        const char *r = getenv("OMPI_COMM_WORLD_RANK");
+        if (!r || !strcmp(r, "0"))
+            fprintf(stderr, "murk: warning: started by an MPI launcher, but this murk was built without MPI "
+                    "(meson -Dmpi=enabled): every process renders the whole image alone\n");
+    }
+    mpi_run.size = murk_mpi_init(err, sizeof err);
+    if (err[0])
+        fprintf(stderr, "murk: warning: %s\n", err);
+    if (mpi_run.size < 2) { /* alone (mpirun -n 1 too) */
+        int rc = render_main(argc, argv);
+        murk_mpi_finalize();
+        return rc;
+    }
+    mpi_run.rank = murk_mpi_rank();
+    if (mpi_run.rank > 0) {
+        mpi_run.capture = tmpfile();
+        mpi_run.saved_fd = mpi_run.capture ? dup(STDERR_FILENO) : -1;
+        if (mpi_run.saved_fd < 0 || dup2(fileno(mpi_run.capture), STDERR_FILENO) < 0) {
+            if (mpi_run.capture)
+                fclose(mpi_run.capture);
+            mpi_run.capture = NULL;
+        }
+    }
+    int rc = render_main(argc, argv);
+    if (!mpi_run.agreed) { /* failed before the ranks agreed: say so, and why */
+        mpi_agree(0, "", NULL);
+        rc = rc ? rc : 1;
+    }
+    int32_t rc0 = rc;
+    murk_mpi_bcast(&rc0, sizeof rc0);
+    murk_mpi_finalize();
+    return rc0;
+}
+
+/* "--part I/N": 0 <= I < N. */
+static int parse_part(const char *v, int *part, int *parts)
+{
+    char a[32], *slash = v ? strchr(v, '/') : NULL;
+    long i, n;
+    if (!slash || (size_t)(slash - v) >= sizeof a) {
+        fprintf(stderr, "murk: --part needs I/N (this process renders part I of N, counted from 0), got '%s'\n",
+                q(v ? v : ""));
+        return -1;
+    }
+    memcpy(a, v, (size_t)(slash - v));
+    a[slash - v] = 0;
+    if (parse_int_arg("--part N", slash + 1, 1, 1 << 20, &n) || parse_int_arg("--part I", a, 0, n - 1, &i))
+        return -1;
+    *part = (int)i, *parts = (int)n;
+    return 0;
+}
+
+static int render_main(int argc, char **argv)
 {
     catch_stop_signals();
     const char *scene_path = NULL, *out = NULL;
@@ -172,6 +303,10 @@ static int cmd_render(int argc, char **argv)
                 return free(sets), 2;
             }
             opts.checkpoint_every = t, every_given = 1, i++;
+        } else if (!strcmp(a, "--part")) {
+            if (parse_part(v, &opts.part, &opts.parts))
+                return free(sets), 2;
+            i++;
         } else if (!strcmp(a, "--set")) {
             if (!v)
                 return free(sets), usage("--set needs KEY.PATH=VALUE");
@@ -194,6 +329,8 @@ static int cmd_render(int argc, char **argv)
         return free(sets), usage("render needs a scene file");
     if (every_given && !opts.checkpoint)
         return free(sets), usage("--every needs --checkpoint");
+    if (opts.parts && opts.time_limit > 0)
+        return free(sets), usage("--part cannot be combined with --time: the parts of an image must have the same spp");
     struct stat sst;
     if (stat(scene_path, &sst) == 0 && !S_ISREG(sst.st_mode)) { /* before deriving an output name from it */
         fprintf(stderr, "%s: is %s, not a scene file\n", q(scene_path), /* as the loader would say it */
@@ -209,7 +346,7 @@ static int cmd_render(int argc, char **argv)
         free(sets);
         return 2;
     }
-    {   /* refuse before rendering: an output path naming a directory, device, FIFO or link */
+    if (mpi_run.rank == 0) { /* refuse before rendering: an output path naming a directory, device, FIFO or link */
         char oerr[1024], *png0 = png_path_for(outbuf);
         int bad = murk_output_check(outbuf, oerr, sizeof oerr) || murk_output_check(png0, oerr, sizeof oerr);
         free(png0);
@@ -229,13 +366,18 @@ static int cmd_render(int argc, char **argv)
         free(sets);
         return 1;
     }
-    opts.progress = !quiet && isatty(STDERR_FILENO);
-    char setbuf[4096] = "";
+    /* under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar */
+    opts.progress = !quiet && (isatty(STDERR_FILENO) || (getenv("MURK_PROGRESS") && !strcmp(getenv("MURK_PROGRESS"), "1")));
+    char setbuf[4096] = "", ckid[4200], parttag[64] = "", fingerprint[4400];
     for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
         k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
-    if (opts.checkpoint || opts.resume) {
+    if (opts.parts)
+        snprintf(parttag, sizeof parttag, "%d/%d", opts.part, opts.parts);
+    if (opts.checkpoint || opts.resume || opts.parts || mpi_run.size > 1) {
         opts.scene_hash = murk_file_hash(scene_path, err, sizeof err);
-        opts.overrides = setbuf;
+        /* a part's checkpoint is no other part's, nor the whole image's */
+        snprintf(ckid, sizeof ckid, "%s%s%s", setbuf, opts.parts ? " --part " : "", parttag);
+        opts.overrides = ckid;
         if (!opts.scene_hash) {
             fprintf(stderr, "%s\n", err);
             murk_scene_free(s);
@@ -244,10 +386,20 @@ static int cmd_render(int argc, char **argv)
             return 1;
         }
     }
+    snprintf(fingerprint, sizeof fingerprint, "scene %016llx, spp %d, seed %llu, %dx%d, part %s, time %g, --set %s",
+             (unsigned long long)opts.scene_hash, opts.spp > 0 ? opts.spp : s->spp, (unsigned long long)s->seed,
+             s->width, s->height, opts.parts ? parttag : "all", opts.time_limit, setbuf);
+    if (mpi_run.size > 1 && mpi_agree(1, fingerprint, NULL)) {
+        murk_scene_free(s);
+        free(outbuf);
+        free(sets);
+        return 1;
+    }
     opts.stop = &render_stop;
     murk_render_result res;
     if (murk_render_err(s, &opts, &res, err, sizeof err) != 0) {
-        fprintf(stderr, "murk: %s\n", err);
+        if (err[0])
+            fprintf(stderr, "murk: %s\n", err);
         if (!res.rgb) {
             murk_scene_free(s);
             free(outbuf);
@@ -256,8 +408,17 @@ static int cmd_render(int argc, char **argv)
         }
     }
     int ck_failed = err[0] != 0;
+    if (mpi_run.rank > 0) { /* rank 0 writes the image; this rank's status is rank 0's */
+        murk_warn_summary();
+        murk_scene_free(s);
+        free(outbuf);
+        free(sets);
+        return 0;
+    }
 
     char spp[32], seed[32], secs[32], nonfinite[32], plugins[4096], interrupted[96] = "no", spp_asked[32];
+    char ranks[32], threads[32], tsecs[32], hash[32], exposure[32], ntiles[32], maxsample[40];
+    snprintf(maxsample, sizeof maxsample, "%.17g", res.max_sample);
     murk_registry_describe(&s->reg, plugins, sizeof plugins);
     snprintf(spp, sizeof spp, "%d", res.spp);
     snprintf(spp_asked, sizeof spp_asked, "%d", opts.spp > 0 ? opts.spp : s->spp);
@@ -267,13 +428,28 @@ static int cmd_render(int argc, char **argv)
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
+    static char counters[16384];
+    murk_cli_counters_json(s, &res, counters, sizeof counters);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
-        {"murk:resumed_from", opts.resume ? opts.resume : ""},
+        {"murk:resumed_from", opts.resume ? opts.resume : ""}, {"murk:counters", counters},
+        {"murk:max_sample", maxsample}, /* the largest channel of a finite sample (murk bench --assemble) */
+        /* the job: processes, render threads, seconds those threads spent in tiles (summed over ranks) */
+        {"murk:ranks", ranks}, {"murk:threads", threads}, {"murk:thread_time", tsecs},
+        /* a --part render: what murk merge checks and needs */
+        {"murk:part", parttag}, {"murk:part_split", "tiles"}, {"murk:part_tiles", ntiles},
+        {"murk:scene_hash", hash}, {"murk:exposure", exposure},
     };
+    snprintf(ranks, sizeof ranks, "%d", res.ranks);
+    snprintf(threads, sizeof threads, "%d", res.threads);
+    snprintf(tsecs, sizeof tsecs, "%.3f", res.thread_seconds);
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)opts.scene_hash);
+    snprintf(exposure, sizeof exposure, "%.9g", (double)s->exposure);
+    snprintf(ntiles, sizeof ntiles, "%d", murk_part_tiles(res.width, res.height, opts.part, opts.parts));
+    int nmeta = (int)(sizeof meta / sizeof meta[0]) - (opts.parts ? 0 : 5); /* the murk:part... keys last */
     char *png = png_path_for(outbuf);
     int rc = ck_failed ? 1 : 0;
     if (res.interrupted)
@@ -281,8 +457,7 @@ static int cmd_render(int argc, char **argv)
                 render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked,
                 opts.checkpoint ? "; resume with --resume " : "", opts.checkpoint ? opts.checkpoint : "");
     murk_output_begin(); /* the EXR and its PNG: both files or neither */
-    if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, (int)(sizeof meta / sizeof meta[0]), err,
-                       sizeof err) != 0 ||
+    if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, nmeta, err, sizeof err) != 0 ||
         murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0 ||
         murk_output_commit(err, sizeof err) != 0) {
         murk_output_abort();
@@ -297,6 +472,7 @@ static int cmd_render(int argc, char **argv)
         human((double)res.rays / res.seconds, rps, sizeof rps);
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
+        murk_cli_counters_print(stdout, s, &res);
     }
     murk_warn_summary();
     if (res.nonfinite)
@@ -432,100 +608,6 @@ static int cmd_plugins(int argc, char **argv)
     return rc;
 }
 
-/* ---- compare ------------------------------------------------------------------------------- */
-
-static int cmp_float(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return (x > y) - (x < y);
-}
-
-static int cmd_compare(int argc, char **argv)
-{
-    const char *a = NULL, *b = NULL, *diff = NULL;
-    for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--diff")) {
-            if (i + 1 >= argc)
-                return usage("--diff needs a .png file name");
-            diff = argv[++i];
-        } else if (!a) {
-            a = argv[i];
-        } else if (!b) {
-            b = argv[i];
-        } else {
-            return usage("compare takes two images");
-        }
-    }
-    if (!a || !b)
-        return usage("compare needs two EXR files: TEST REFERENCE");
-    murk_image A = {0}, B = {0};
-    char err[1024];
-    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
-        cli_error(err);
-        murk_image_free(&A);
-        return 1;
-    }
-    int rc = 0;
-    if (A.w != B.w || A.h != B.h) {
-        fprintf(stderr, "murk: %s is %dx%d but %s is %dx%d\n", a, A.w, A.h, b, B.w, B.h);
-        rc = 1;
-    } else {
-        size_t n = (size_t)A.w * (size_t)A.h;
-        double mse = 0, rel = 0, mar = 0;
-        size_t bad = 0;
-        float *d = murk_xmalloc(n * sizeof(float));
-        for (size_t i = 0; i < n; i++) {
-            double dp = 0;
-            for (int c = 0; c < 3; c++) {
-                double x = A.rgb[3 * i + (size_t)c], r = B.rgb[3 * i + (size_t)c];
-                if (!isfinite(x) || !isfinite(r)) {
-                    bad++;
-                    continue;
-                }
-                double e = x - r;
-                mse += e * e;
-                rel += e * e / (r * r + 1e-2);
-                mar += fabs(e) / (fabs(r) + 1e-2);
-                dp += fabs(e);
-            }
-            d[i] = (float)(dp / 3);
-        }
-        double m = 3.0 * (double)n;
-        printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
-               mse / m, rel / m, mar / m, a, b);
-        if (bad)
-            printf("warning: %zu non-finite values skipped\n", bad);
-        if (diff) {
-            float *sorted = murk_xmalloc(n * sizeof(float));
-            memcpy(sorted, d, n * sizeof(float));
-            qsort(sorted, n, sizeof(float), cmp_float);
-            float p99 = sorted[(size_t)(0.99 * (double)(n - 1))];
-            float scale = p99 > 0 ? 1.0f / p99 : 1.0f;
-            free(sorted);
-            float *rgb = murk_xmalloc(3 * n * sizeof(float));
-            for (size_t i = 0; i < n; i++) { /* black -> red -> yellow -> white heat map */
-                float t = fminf(1.0f, d[i] * scale);
-                rgb[3 * i] = fminf(1.0f, 3 * t);
-                rgb[3 * i + 1] = fminf(1.0f, fmaxf(0.0f, 3 * t - 1));
-                rgb[3 * i + 2] = fmaxf(0.0f, 3 * t - 2);
-                for (int c = 0; c < 3; c++) /* the PNG writer applies the sRGB curve: undo it */
-                    rgb[3 * i + (size_t)c] = powf(rgb[3 * i + (size_t)c], 2.2f);
-            }
-            if (murk_png_write(diff, rgb, A.w, A.h, 0.0f, err, sizeof err)) {
-                cli_error(err);
-                rc = 1;
-            } else {
-                printf("diff image %s: |a-b| averaged over channels, white = 99th percentile (%.3e)\n", diff, p99);
-            }
-            free(rgb);
-        }
-        free(d);
-    }
-    murk_image_free(&A);
-    murk_image_free(&B);
-    return rc;
-}
-
 /* ---- grid ---------------------------------------------------------------------------------- */
 
 /* A number read as strictly as the scene's (yread.c): a whole decimal token, no leading space, no hex,
@@ -655,11 +737,15 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "plugins"))
         return cmd_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
-        return cmd_compare(argc - 2, argv + 2);
+        return murk_cli_compare(argc - 2, argv + 2);
+    if (!strcmp(cmd, "bench"))
+        return murk_cli_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "check"))
         return murk_check_main(argc - 1, argv + 1);
     if (!strcmp(cmd, "grid"))
         return cmd_grid(argc - 2, argv + 2);
+    if (!strcmp(cmd, "merge"))
+        return murk_cli_merge(argc - 2, argv + 2);
     if (!strcmp(cmd, "--version")) {
         printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
         return 0;

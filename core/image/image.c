@@ -54,7 +54,7 @@ uint64_t murk_image_fd_size(int fd)
     return fstat(fd, &st) == 0 && st.st_size > 0 ? (uint64_t)st.st_size : 0;
 }
 
-const char *murk_image_meta(const murk_image *img, const char *key)
+MURK_API const char *murk_image_meta(const murk_image *img, const char *key)
 {
     for (int i = 0; img && key && i < img->nmeta; i++)
         if (img->meta[i].key && strcmp(img->meta[i].key, key) == 0)

@@ -37,24 +37,33 @@ struct murk_density {
     murk_field *field;
     murk_bound_grid grid;
     float factor;
+    unsigned slot; /* its medium's cost counters (host.h) */
 };
 
 typedef struct walk {
     murk_dda dda;
     float factor;
+    murk_counters *count; /* this thread's block for the medium (host.h), taken once per walk */
 } walk;
 
 _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
 
 /* ---- host services ------------------------------------------------------------------------- */
 
-float murk_media_density(const murk_density *d, murk_vec3 p) { return murk_field_eval(d->field, p); }
+float murk_media_density(const murk_density *d, murk_vec3 p)
+{
+    murk_thread_counters[d->slot].lookups++;
+    return murk_field_eval(d->field, p);
+}
+
+murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_counters[d->slot]; }
 
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w)
 {
     walk *k = (walk *)(void *)w;
     murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
     k->factor = d->factor;
+    k->count = &murk_thread_counters[d->slot];
 }
 
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
@@ -62,6 +71,7 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     walk *k = (walk *)(void *)w;
     float mx = 0.0f, mn = 0.0f;
     int r = murk_dda_next(&k->dda, ta, tb, &mx, &mn);
+    k->count->cells += (unsigned)r;
     if (dmax)
         *dmax = mx * k->factor;
     if (dmin)
@@ -296,6 +306,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     double mf = core[K_MAJORANT_FACTOR].f[0];
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);
+    nm->density->slot = murk_counter_slot(s->nmedia);
     nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
     if (!nm->density->field)
         return -1;
@@ -377,6 +388,7 @@ int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen
             memset(nm, 0, sizeof *nm);
             return -1;
         }
+        murk_host_count_medium(&nm->m, nm->density->slot);
         s->nmedia++;
     }
     return 0;

@@ -25,6 +25,8 @@ void murk_media_free(murk_scene *s);
 float murk_media_density(const murk_density *d, murk_vec3 p);
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
+/* The calling thread's cost counters for d's medium (host.h): the host's counters() service. */
+murk_counters *murk_media_counters(const murk_density *d);
 void murk_warn_once(const char *fmt, ...) MURK_PRINTF(1, 2);
 /* Prints how often each once-only warning repeated, and forgets them. */
 void murk_warn_summary(void);

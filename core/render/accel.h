@@ -10,5 +10,8 @@
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 void murk_lights_build(murk_scene *s);
+/* The host's sample_light_with / light_pdf_with (murk/plugin.h); strategy: MURK_LIGHT_*. */
+int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int strategy, murk_light_sample *ls);
+float murk_lights_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h, int strategy);
 
 #endif

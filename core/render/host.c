@@ -1,7 +1,8 @@
 /* host.c — the services table plugins receive: memory, logging, textures, and the scene queries
- * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays are counted
- * per thread for the rays/s figure. */
+ * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays and the cost
+ * counters (murk/counters.h) are counted per thread and summed by render.c when a thread's work ends. */
 #include "host.h"
+#include "accel.h"
 #include "media.h"
 #include "scene.h"
 #include "texture.h"
@@ -13,9 +14,91 @@
 #include <string.h>
 
 static _Thread_local uint64_t thread_rays;
+_Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
 
 uint64_t murk_host_thread_rays(void) { return thread_rays; }
-void murk_host_thread_reset(void) { thread_rays = 0; }
+
+void murk_host_thread_reset(void)
+{
+    thread_rays = 0;
+    memset(murk_thread_counters, 0, sizeof murk_thread_counters);
+}
+
+void murk_host_thread_counters_add(murk_counters *sum, size_t n)
+{
+    for (size_t i = 0; i < n && i < MURK_COUNTER_SLOTS; i++) {
+        const murk_counters *c = &murk_thread_counters[i];
+        sum[i].lookups += c->lookups;
+        sum[i].cells += c->cells;
+        sum[i].collisions += c->collisions;
+        sum[i].scatters += c->scatters;
+        sum[i].shadow += c->shadow;
+    }
+}
+
+/* ---- counting wrappers around a medium's tracker and estimator ------------------------------ */
+
+typedef struct counted {
+    const murk_medium_vt *vt; /* the tracker's own */
+    void *self;
+    const murk_transmittance_vt *tr_vt; /* the estimator's own, or NULL */
+    void *tr_self;
+    unsigned slot;
+} counted;
+
+static void counted_destroy(void *self)
+{
+    counted *c = self;
+    if (c->self)
+        c->vt->destroy(c->self);
+    if (c->tr_self)
+        c->tr_vt->destroy(c->tr_self);
+    free(c);
+}
+
+static void counted_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                           murk_medium_event *ev)
+{
+    const counted *c = self;
+    c->vt->sample(c->self, ray, ctx, rng, ev);
+    murk_thread_counters[c->slot].scatters += ev->scattered != 0;
+}
+
+static murk_rgb counted_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    const counted *c = self;
+    murk_thread_counters[c->slot].shadow++;
+    return c->vt->transmittance(c->self, ray, ctx, rng);
+}
+
+static void counted_estimator_destroy(void *self) { (void)self; /* counted_destroy frees the estimator */ }
+
+static murk_rgb counted_estimate(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    const counted *c = self;
+    murk_thread_counters[c->slot].shadow++;
+    return c->tr_vt->estimate(c->tr_self, ray, ctx, rng);
+}
+
+static const murk_medium_vt counted_vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, NULL, counted_destroy,
+                                          counted_sample, counted_transmittance};
+
+static const murk_transmittance_vt counted_est_vt = {sizeof(murk_transmittance_vt), MURK_KIND_TRANSMITTANCE, NULL,
+                                                     counted_estimator_destroy, counted_estimate};
+
+void murk_host_count_medium(murk_medium *m, unsigned slot)
+{
+    if (!m->vt || !m->self)
+        return;
+    counted *c = murk_xmalloc(sizeof *c);
+    *c = (counted){m->vt, m->self, m->tr_self ? m->tr_vt : NULL, m->tr_self, slot};
+    m->vt = &counted_vt;
+    m->self = c;
+    if (c->tr_vt) {
+        m->tr_vt = &counted_est_vt;
+        m->tr_self = c;
+    }
+}
 
 static void *host_alloc(size_t n) { return calloc(1, n ? n : 1); }
 static void host_free(void *p) { free(p); }
@@ -138,91 +221,15 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     return er.tfar < 0.0f;
 }
 
-/* 1 - cos(theta_max) of the cone a sphere subtends from distance d > r, accurate when tiny. */
-static float cone_one_minus_cos(float r, float d)
-{
-    float sin2 = (r * r) / (d * d);
-    float cosm = sqrtf(murk_maxf(0.0f, 1.0f - sin2));
-    return sin2 / (1.0f + cosm);
-}
-
+/* Light sampling lives in lights.c; 1.3's services are the area strategy. */
 static int host_sample_light(const murk_scene *s, murk_vec3 p, const float u[3], murk_light_sample *ls)
 {
-    memset(ls, 0, sizeof *ls);
-    if (s->nlights == 0 || s->light_power <= 0.0f)
-        return 0;
-    size_t lo = 0, hi = s->nlights; /* find i with cdf[i] <= u0 < cdf[i+1] */
-    while (hi - lo > 1) {
-        size_t mid = (lo + hi) / 2;
-        if (s->light_cdf[mid] <= u[0])
-            lo = mid;
-        else
-            hi = mid;
-    }
-    while (lo > 0 && s->lights[lo].pmf <= 0.0f) /* never land on a zero-power light */
-        lo--;
-    const murk_light *l = &s->lights[lo];
-    if (l->pmf <= 0.0f)
-        return 0;
-    if (l->sphere) {
-        murk_vec3 dc = murk_sub(l->center, p);
-        float d = murk_length(dc);
-        if (d <= l->radius * 1.0001f)
-            return 0; /* inside (or on) an outward-emitting sphere: it sends nothing this way */
-        murk_vec3 w = murk_mul(dc, 1.0f / d), t, b;
-        murk_basis(w, &t, &b);
-        float omc = cone_one_minus_cos(l->radius, d);
-        float one_minus_cos = u[1] * omc;
-        float cost = 1.0f - one_minus_cos;
-        float sint = sqrtf(murk_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
-        float phi = 2.0f * MURK_PI * u[2];
-        murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
-        /* distance to the near intersection along dir */
-        float bq = murk_dot(dir, dc);
-        float disc = l->radius * l->radius - (d * d - bq * bq);
-        float dist = bq - sqrtf(murk_maxf(0.0f, disc));
-        ls->wi = dir;
-        ls->dist = murk_maxf(dist, 0.0f);
-        ls->le = l->le;
-        ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
-        return ls->pdf > 0.0f && isfinite(ls->pdf);
-    }
-    float su = sqrtf(u[1]);
-    murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
-    murk_vec3 d = murk_sub(q, p);
-    float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
-    if (dist <= 0.0f)
-        return 0;
-    murk_vec3 wi = murk_mul(d, 1.0f / dist);
-    float cosl = -murk_dot(l->n, wi);
-    if (cosl <= 0.0f)
-        return 0;
-    ls->wi = wi;
-    ls->dist = dist;
-    ls->le = l->le;
-    ls->pdf = l->pmf * dist2 / (cosl * l->area);
-    return isfinite(ls->pdf) && ls->pdf > 0.0f;
+    return murk_lights_sample(s, p, u, MURK_LIGHT_AREA, ls);
 }
 
 static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
 {
-    if (h->light < 0 || (size_t)h->light >= s->nlights)
-        return 0.0f;
-    const murk_light *l = &s->lights[h->light];
-    if (l->sphere) {
-        float d = murk_length(murk_sub(l->center, p));
-        if (d <= l->radius * 1.0001f)
-            return 0.0f;
-        return l->pmf / (2.0f * MURK_PI * cone_one_minus_cos(l->radius, d));
-    }
-    murk_vec3 dv = murk_sub(h->p, p);
-    float dist2 = murk_dot(dv, dv);
-    if (dist2 <= 0.0f)
-        return 0.0f;
-    float cosl = -murk_dot(l->n, dv) / sqrtf(dist2);
-    if (cosl <= 0.0f)
-        return 0.0f;
-    return l->pmf * dist2 / (cosl * l->area);
+    return murk_lights_pdf(s, p, h, MURK_LIGHT_AREA);
 }
 
 static murk_rgb host_background(const murk_scene *s, murk_vec3 dir)
@@ -253,6 +260,9 @@ static const murk_host host_table = {
     .warn_once = murk_warn_once,
     .phase_eval = murk_phase_hg_eval,
     .phase_sample = murk_phase_hg_sample,
+    .counters = murk_media_counters,
+    .sample_light_with = murk_lights_sample,
+    .light_pdf_with = murk_lights_pdf,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }

@@ -3,11 +3,33 @@
 #define MURK_HOST_H
 
 #include <stdint.h>
-#include "murk/plugin.h"
+#include "murk/medium.h"
 
 const murk_host *murk_host_table(void);
 /* Rays traced by the calling thread since its last reset (intersect + occluded calls). */
 uint64_t murk_host_thread_rays(void);
+/* Zeroes the calling thread's ray count and cost counters. */
 void murk_host_thread_reset(void);
+
+/* The calling thread's cost counters (murk/counters.h), one block per counter slot: a medium's slot is
+ * its index in the scene (the last slot is shared by the media beyond it). Plain thread-local memory:
+ * the hot paths (density lookups, majorant cells) add to it without atomics or locks. */
+#if defined(__GNUC__)
+extern _Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS] __attribute__((tls_model("initial-exec")));
+#else
+extern _Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
+#endif
+/* Adds the calling thread's first n blocks into sum[0..n) (once per thread when its work ends). */
+void murk_host_thread_counters_add(murk_counters *sum, size_t n);
+/* The slot for the scene's i-th medium. */
+static inline unsigned murk_counter_slot(size_t i)
+{
+    return i < MURK_COUNTER_SLOTS - 1 ? (unsigned)i : MURK_COUNTER_SLOTS - 1;
+}
+
+/* Wraps a scene's medium (its tracker and, if any, its transmittance estimator) so that every free
+ * flight that scatters and every transmittance estimate is counted in the medium's slot. The wrapped
+ * destroy() frees the wrapper too. */
+void murk_host_count_medium(murk_medium *m, unsigned slot);
 
 #endif

@@ -1,11 +1,15 @@
 /* lights.c — emissive shapes as lights: one light per emitting triangle or sphere, chosen in
  * proportion to its power (luminance x area), sampled uniformly by area (triangles) or uniformly in
  * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
- * normal only; spheres emit outwards. */
+ * normal only; spheres emit outwards. With MURK_LIGHT_SOLID_ANGLE (murk/plugin.h) the two triangles of
+ * a rectangular quad or box face are sampled together, uniformly in the solid angle of the rectangle
+ * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"). */
 #include "accel.h"
 #include "util.h"
 
+#include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 static void add_light(murk_scene *s, size_t *cap, const murk_light *l)
 {
@@ -62,4 +66,215 @@ void murk_lights_build(murk_scene *s)
     }
     s->light_cdf[s->nlights] = 1.0f;
     s->light_power = (float)total;
+    /* quads and box faces: triangles 2q (p0 p1 p2) and 2q + 1 (p0 p2 p3) of a rectangle (load.c's put_quad) */
+    for (size_t i = 0; i < s->nshapes; i++) {
+        const murk_shape *sh = &s->shapes[i];
+        if (sh->light_base < 0 || (sh->type != MURK_SHAPE_QUAD && sh->type != MURK_SHAPE_BOX))
+            continue;
+        for (uint32_t t = 0; t + 1 < sh->ntris; t += 2) {
+            murk_light *a = &s->lights[sh->light_base + (int32_t)t], *b = a + 1;
+            murk_vec3 ex = a->e1, ey = b->e2; /* p1 - p0, p3 - p0 */
+            float lx = murk_length(ex), ly = murk_length(ey);
+            if (!(lx > 0.0f && ly > 0.0f) || fabsf(murk_dot(ex, ey)) > 1e-5f * lx * ly)
+                continue; /* a parallelogram: by area */
+            a->rect = b->rect = 1;
+            a->rp0 = b->rp0 = a->p0;
+            a->rex = b->rex = ex;
+            a->rey = b->rey = ey;
+            a->rect_pmf = b->rect_pmf = a->pmf + b->pmf;
+        }
+    }
+}
+
+/* ---- spherical rectangles -------------------------------------------------------------------------- */
+
+/* The rectangle seen from p in its own frame: x along ex, y along ey, z towards p's side flipped so that
+ * the rectangle lies at z0 < 0 from p; the four corner-plane normals' angles give the solid angle. */
+typedef struct srect {
+    double x0, y0, x1, y1, z0;
+    double n0z, n2z, g0, g1, g2, g3, omega;
+    murk_vec3 ax, ay, az; /* unit frame */
+} srect;
+
+static double angle_between(const double a[3], const double b[3])
+{ /* numerically stable angle between unit vectors */
+    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    if (d < 0.0) {
+        double s[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+        return M_PI - 2.0 * asin(fmin(1.0, sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / 2.0));
+    }
+    double s[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    return 2.0 * asin(fmin(1.0, sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / 2.0));
+}
+
+static void cross_unit(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+    double l = sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    if (l > 0.0)
+        out[0] /= l, out[1] /= l, out[2] /= l;
+}
+
+/* Fills r for the rectangle of l seen from p; returns 0 if p is not on its emitting side. */
+static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
+{
+    float lx = murk_length(l->rex), ly = murk_length(l->rey);
+    r->ax = murk_mul(l->rex, 1.0f / lx);
+    r->ay = murk_mul(l->rey, 1.0f / ly);
+    r->az = murk_cross(r->ax, r->ay); /* the emitting side (n = normalize(ex x ey)) */
+    murk_vec3 d = murk_sub(l->rp0, p);
+    r->x0 = murk_dot(d, r->ax);
+    r->y0 = murk_dot(d, r->ay);
+    r->z0 = murk_dot(d, r->az);
+    if (!(r->z0 < 0.0)) /* p behind the emitting side or on the plane */
+        return 0;
+    r->x1 = r->x0 + lx;
+    r->y1 = r->y0 + ly;
+    double v00[3] = {r->x0, r->y0, r->z0}, v01[3] = {r->x0, r->y1, r->z0};
+    double v10[3] = {r->x1, r->y0, r->z0}, v11[3] = {r->x1, r->y1, r->z0};
+    double n0[3], n1[3], n2[3], n3[3], m0[3], m1[3], m2[3], m3[3];
+    cross_unit(v00, v10, n0);
+    cross_unit(v10, v11, n1);
+    cross_unit(v11, v01, n2);
+    cross_unit(v01, v00, n3);
+    for (int i = 0; i < 3; i++)
+        m0[i] = -n0[i], m1[i] = -n1[i], m2[i] = -n2[i], m3[i] = -n3[i];
+    r->g0 = angle_between(m0, n1);
+    r->g1 = angle_between(m1, n2);
+    r->g2 = angle_between(m2, n3);
+    r->g3 = angle_between(m3, n0);
+    r->n0z = n0[2];
+    r->n2z = n2[2];
+    r->omega = r->g0 + r->g1 + r->g2 + r->g3 - 2.0 * M_PI;
+    return 1;
+}
+
+/* Below this solid angle (sr) the spherical-rectangle formulas lose their precision: sampled by area. */
+#define MIN_RECT_OMEGA 1e-4
+
+/* A point uniformly in the solid angle of r (u in [0, 1)^2), in world space. */
+static murk_vec3 srect_sample(const srect *r, murk_vec3 p, float su, float sv)
+{
+    double au = su * (r->g0 + r->g1 - 2.0 * M_PI) + (su - 1.0) * (r->g2 + r->g3);
+    double fu = (cos(au) * r->n0z - r->n2z) / sin(au);
+    double cu = copysign(1.0 / sqrt(fu * fu + r->n0z * r->n0z), fu);
+    cu = fmin(fmax(cu, -0.999999999), 0.999999999);
+    double xu = -(cu * r->z0) / sqrt(1.0 - cu * cu);
+    xu = fmin(fmax(xu, r->x0), r->x1);
+    double dd = sqrt(xu * xu + r->z0 * r->z0);
+    double h0 = r->y0 / sqrt(dd * dd + r->y0 * r->y0), h1 = r->y1 / sqrt(dd * dd + r->y1 * r->y1);
+    double hv = h0 + sv * (h1 - h0), hv2 = hv * hv;
+    double yv = hv2 < 1.0 - 1e-12 ? hv * dd / sqrt(1.0 - hv2) : r->y1;
+    yv = fmin(fmax(yv, r->y0), r->y1);
+    return murk_add(p, murk_add(murk_add(murk_mul(r->ax, (float)xu), murk_mul(r->ay, (float)yv)),
+                                murk_mul(r->az, (float)r->z0)));
+}
+
+/* ---- sampling -------------------------------------------------------------------------------------- */
+
+
+
+/* 1 - cos(theta_max) of the cone a sphere subtends from distance d > r, accurate when tiny. */
+static float cone_one_minus_cos(float r, float d)
+{
+    float sin2 = (r * r) / (d * d);
+    float cosm = sqrtf(murk_maxf(0.0f, 1.0f - sin2));
+    return sin2 / (1.0f + cosm);
+}
+
+int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int strategy, murk_light_sample *ls)
+{
+    memset(ls, 0, sizeof *ls);
+    if (s->nlights == 0 || s->light_power <= 0.0f)
+        return 0;
+    size_t lo = 0, hi = s->nlights; /* find i with cdf[i] <= u0 < cdf[i+1] */
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (s->light_cdf[mid] <= u[0])
+            lo = mid;
+        else
+            hi = mid;
+    }
+    while (lo > 0 && s->lights[lo].pmf <= 0.0f) /* never land on a zero-power light */
+        lo--;
+    const murk_light *l = &s->lights[lo];
+    if (l->pmf <= 0.0f)
+        return 0;
+    if (l->sphere) {
+        murk_vec3 dc = murk_sub(l->center, p);
+        float d = murk_length(dc);
+        if (d <= l->radius * 1.0001f)
+            return 0; /* inside (or on) an outward-emitting sphere: it sends nothing this way */
+        murk_vec3 w = murk_mul(dc, 1.0f / d), t, b;
+        murk_basis(w, &t, &b);
+        float omc = cone_one_minus_cos(l->radius, d);
+        float one_minus_cos = u[1] * omc;
+        float cost = 1.0f - one_minus_cos;
+        float sint = sqrtf(murk_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+        float phi = 2.0f * MURK_PI * u[2];
+        murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
+        /* distance to the near intersection along dir */
+        float bq = murk_dot(dir, dc);
+        float disc = l->radius * l->radius - (d * d - bq * bq);
+        float dist = bq - sqrtf(murk_maxf(0.0f, disc));
+        ls->wi = dir;
+        ls->dist = murk_maxf(dist, 0.0f);
+        ls->le = l->le;
+        ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
+        return ls->pdf > 0.0f && isfinite(ls->pdf);
+    }
+    srect r;
+    if (strategy == MURK_LIGHT_SOLID_ANGLE && l->rect && srect_setup(l, p, &r) && r.omega >= MIN_RECT_OMEGA) {
+        murk_vec3 q = srect_sample(&r, p, u[1], u[2]);
+        murk_vec3 d = murk_sub(q, p);
+        float dist = murk_length(d);
+        if (!(dist > 0.0f))
+            return 0;
+        ls->wi = murk_mul(d, 1.0f / dist);
+        ls->dist = dist;
+        ls->le = l->le;
+        ls->pdf = (float)(l->rect_pmf / r.omega);
+        return isfinite(ls->pdf) && ls->pdf > 0.0f;
+    }
+    float su = sqrtf(u[1]);
+    murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+    murk_vec3 d = murk_sub(q, p);
+    float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
+    if (dist <= 0.0f)
+        return 0;
+    murk_vec3 wi = murk_mul(d, 1.0f / dist);
+    float cosl = -murk_dot(l->n, wi);
+    if (cosl <= 0.0f)
+        return 0;
+    ls->wi = wi;
+    ls->dist = dist;
+    ls->le = l->le;
+    ls->pdf = l->pmf * dist2 / (cosl * l->area);
+    return isfinite(ls->pdf) && ls->pdf > 0.0f;
+}
+
+float murk_lights_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h, int strategy)
+{
+    if (h->light < 0 || (size_t)h->light >= s->nlights)
+        return 0.0f;
+    const murk_light *l = &s->lights[h->light];
+    if (l->sphere) {
+        float d = murk_length(murk_sub(l->center, p));
+        if (d <= l->radius * 1.0001f)
+            return 0.0f;
+        return l->pmf / (2.0f * MURK_PI * cone_one_minus_cos(l->radius, d));
+    }
+    srect r;
+    if (strategy == MURK_LIGHT_SOLID_ANGLE && l->rect && srect_setup(l, p, &r) && r.omega >= MIN_RECT_OMEGA)
+        return (float)(l->rect_pmf / r.omega);
+    murk_vec3 dv = murk_sub(h->p, p);
+    float dist2 = murk_dot(dv, dv);
+    if (dist2 <= 0.0f)
+        return 0.0f;
+    float cosl = -murk_dot(l->n, dv) / sqrtf(dist2);
+    if (cosl <= 0.0f)
+        return 0.0f;
+    return l->pmf * dist2 / (cosl * l->area);
 }

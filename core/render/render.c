@@ -1,12 +1,25 @@
 /* render.c — tiles over a thread pool. Each (pixel, sample) has its own random stream seeded from
  * (seed, pixel, sample) and each pixel is accumulated by one thread in sample order, so the image is
- * bitwise identical for any thread count. Non-finite samples are counted and left out of the pixel. */
+ * bitwise identical for any thread count. Non-finite samples are counted and left out of the pixel.
+ *
+ * Under MPI (mpi_job.h) the same holds for any number of ranks. Rank 0 keeps every pixel's state and
+ * decides the passes (the sample ranges: --time, checkpoints and signals are its decisions alone, sent
+ * to every rank before each pass). Within a pass its threads take tiles from the shared counter and its
+ * main thread hands tiles out to the other ranks on request, one per request: a rank asks for as many
+ * tiles as it has threads plus one when the pass starts and for one more with each tile it returns, so
+ * a heavy tile holds up one thread, never a rank's queue. A tile travels with its pixels' sums and
+ * counts (none in a render's first pass) and comes back with them advanced by the pass's samples in
+ * sample order: no pixel is ever summed across ranks, so the sums are the single-process ones bit for
+ * bit. Messages per tile and pass: one TILE (16 bytes + 28 per pixel of state) and one RESULT (8 + 28
+ * per pixel). After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
 #include "checkpoint.h"
 #include "error.h"
 #include "host.h"
+#include "mpi_job.h"
 #include "scene.h"
 #include "util.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -22,20 +35,98 @@
 
 enum { TILE = 16 };
 
+/* Tile numbers handed between a rank's main thread and its render threads (MPI ranks other than 0):
+ * each tile enters at most once per pass, so ntiles slots never overflow. */
+typedef struct tile_queue {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int *t;
+    int head, tail, closed;
+} tile_queue;
+
 typedef struct job {
     const murk_scene *s;
     int spp0, spp1; /* sample range of this pass */
     double *sum;    /* 3 per pixel */
     uint32_t *count;
     int tiles_x, ntiles;
+    const int *tiles; /* the ntiles tile numbers rendered (all, or one --part's) */
     atomic_int next;
     atomic_int done;
-    atomic_uint_fast64_t rays, nonfinite;
+    atomic_uint_fast64_t rays, nonfinite, busy_ns;
     volatile sig_atomic_t *stop; /* set: take no more tiles; the pass is abandoned */
     atomic_int abandoned;
+    pthread_mutex_t lock; /* guards media: each thread adds its cost counters once, when it ends */
+    size_t nslots;
+    murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel of a finite sample */
+    tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
+    /* rank 0 under MPI (MURK_MPI_STATS=1 prints them): tiles handed to other ranks, messages and bytes
+     * received and sent, seconds its main thread spent handling them, passes */
+    uint64_t mpi_tiles, mpi_msgs, mpi_bytes, mpi_passes;
+    double mpi_serve;
     float *dump; /* MURK_SAMPLE_DUMP: every sample's RGB, [pixel][sample][3], non-finite ones too */
     int dump_spp;
 } job;
+
+static void queue_init(tile_queue *q, int n)
+{
+    pthread_mutex_init(&q->mu, NULL);
+    pthread_cond_init(&q->cv, NULL);
+    q->t = murk_xmalloc((size_t)(n > 0 ? n : 1) * sizeof *q->t);
+    q->head = q->tail = q->closed = 0;
+}
+
+static void queue_free(tile_queue *q)
+{
+    pthread_mutex_destroy(&q->mu);
+    pthread_cond_destroy(&q->cv);
+    free(q->t);
+}
+
+static void queue_push(tile_queue *q, int t)
+{
+    pthread_mutex_lock(&q->mu);
+    q->t[q->tail++] = t;
+    pthread_cond_signal(&q->cv);
+    pthread_mutex_unlock(&q->mu);
+}
+
+/* The next tile, or -1 once the queue is empty and (wait) closed or (!wait) at once. */
+static int queue_pop(tile_queue *q, int wait)
+{
+    pthread_mutex_lock(&q->mu);
+    while (wait && q->head == q->tail && !q->closed)
+        pthread_cond_wait(&q->cv, &q->mu);
+    int t = q->head < q->tail ? q->t[q->head++] : -1;
+    pthread_mutex_unlock(&q->mu);
+    return t;
+}
+
+static void queue_close(tile_queue *q)
+{
+    pthread_mutex_lock(&q->mu);
+    q->closed = 1;
+    pthread_cond_broadcast(&q->cv);
+    pthread_mutex_unlock(&q->mu);
+}
+
+/* The next tile of this pass for a render thread, or -1 when there is none. */
+static int take_tile(job *j)
+{
+    if (j->inq)
+        return queue_pop(j->inq, 1);
+    int k = atomic_fetch_add(&j->next, 1);
+    return k < j->ntiles ? j->tiles[k] : -1;
+}
+
+static void tile_done(job *j, int t, double seconds)
+{
+    atomic_fetch_add(&j->busy_ns, (uint64_t)(seconds * 1e9));
+    if (j->outq)
+        queue_push(j->outq, t);
+    atomic_fetch_add(&j->done, 1);
+}
 
 static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
 {
@@ -58,15 +149,17 @@ static void *worker(void *arg)
     const murk_scene *s = j->s;
     murk_host_thread_reset();
     uint64_t bad = 0;
+    float peak = 0.0f;
     for (;;) {
         if (j->stop && *j->stop) {
             if (atomic_load(&j->next) < j->ntiles)
                 atomic_store(&j->abandoned, 1);
             break;
         }
-        int t = atomic_fetch_add(&j->next, 1);
-        if (t >= j->ntiles)
+        int t = take_tile(j);
+        if (t < 0)
             break;
+        double t_tile = murk_now();
         int x0 = (t % j->tiles_x) * TILE, y0 = (t / j->tiles_x) * TILE;
         int x1 = x0 + TILE < s->width ? x0 + TILE : s->width, y1 = y0 + TILE < s->height ? y0 + TILE : s->height;
         for (int y = y0; y < y1; y++)
@@ -76,10 +169,11 @@ static void *worker(void *arg)
                 uint32_t n = j->count[pix];
                 for (int k = j->spp0; k < j->spp1; k++) {
                     murk_rng rng;
-                    murk_rng_seed(&rng, s->seed, pix, (uint64_t)k);
-                    float jx = murk_rng_float(&rng), jy = murk_rng_float(&rng);
+                    float jit[2]; /* slot 0 of the sampler (murk/math.h) */
+                    murk_sampler_start(&rng, s->sampler, s->seed, pix, (uint32_t)k);
+                    murk_sample_2d(&rng, jit);
                     murk_ray r;
-                    camera_ray(s, (float)x + jx, (float)y + jy, &r);
+                    camera_ray(s, (float)x + jit[0], (float)y + jit[1], &r);
                     murk_rgb L = s->integrator_vt->li(s->integrator, s, &r, &rng);
                     if (j->dump && k < j->dump_spp)
                         memcpy(j->dump + 3 * (pix * (size_t)j->dump_spp + (size_t)k), L.c, sizeof L.c);
@@ -88,15 +182,22 @@ static void *worker(void *arg)
                         continue;
                     }
                     acc[0] += L.c[0], acc[1] += L.c[1], acc[2] += L.c[2];
+                    for (int c = 0; c < 3; c++) /* plain compares: fmaxf is a libm call here */
+                        peak = fabsf(L.c[c]) > peak ? fabsf(L.c[c]) : peak;
                     n++;
                 }
                 j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];
                 j->count[pix] = n;
             }
-        atomic_fetch_add(&j->done, 1);
+        tile_done(j, t, murk_now() - t_tile);
     }
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
+    pthread_mutex_lock(&j->lock);
+    murk_host_thread_counters_add(j->media, j->nslots);
+    if (peak > j->max_sample)
+        j->max_sample = peak;
+    pthread_mutex_unlock(&j->lock);
     return NULL;
 }
 
@@ -112,21 +213,207 @@ static void progress_bar(double frac, double elapsed)
     fflush(stderr);
 }
 
-/* Renders samples [spp0, spp1) of every pixel on nthreads threads. */
-static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_total, int spp_before)
+/* ---- tiles between ranks ---------------------------------------------------------------------- */
+
+/* The pixel rectangle of tile t. */
+static void tile_rect(const job *j, int t, int *x0, int *y0, int *x1, int *y1)
+{
+    const murk_scene *s = j->s;
+    *x0 = (t % j->tiles_x) * TILE, *y0 = (t / j->tiles_x) * TILE;
+    *x1 = *x0 + TILE < s->width ? *x0 + TILE : s->width, *y1 = *y0 + TILE < s->height ? *y0 + TILE : s->height;
+}
+
+/* Bytes of a tile's state: 3 double sums and a uint32 count per pixel. */
+enum { PIX_BYTES = 3 * sizeof(double) + sizeof(uint32_t), TILE_BYTES = TILE * TILE * PIX_BYTES };
+
+/* Copies tile t's state to (dir > 0) or from (dir < 0) the buffer p, or clears it (dir == 0). */
+static void tile_state(job *j, int t, unsigned char *p, int dir)
+{
+    int x0, y0, x1, y1;
+    tile_rect(j, t, &x0, &y0, &x1, &y1);
+    for (int y = y0; y < y1; y++) {
+        size_t pix = (size_t)y * (size_t)j->s->width + (size_t)x0, n = (size_t)(x1 - x0);
+        double *sum = j->sum + 3 * pix;
+        uint32_t *count = j->count + pix;
+        if (dir > 0) {
+            memcpy(p, sum, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
+            memcpy(p, count, n * sizeof *count), p += n * sizeof *count;
+        } else if (dir < 0) {
+            memcpy(sum, p, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
+            memcpy(count, p, n * sizeof *count), p += n * sizeof *count;
+        } else {
+            memset(sum, 0, 3 * n * sizeof *sum);
+            memset(count, 0, n * sizeof *count);
+        }
+    }
+}
+
+/* Rank 0: answers one request of rank `to` with a tile (and its state, after the first pass) or, when
+ * there is none left or the pass is being abandoned, with END. */
+static void hand_out(job *j, int to, int stopped, int *remote)
+{
+    int k = stopped ? j->ntiles : atomic_fetch_add(&j->next, 1);
+    j->mpi_msgs++;
+    if (k >= j->ntiles) {
+        int32_t *end = murk_xmalloc(sizeof *end);
+        murk_mpi_post(to, MURK_TAG_END, end, sizeof *end);
+        j->mpi_bytes += sizeof *end;
+        return;
+    }
+    int t = j->tiles[k], state = j->spp0 > 0;
+    size_t n = 16 + (state ? TILE_BYTES : 0);
+    unsigned char *msg = murk_xmalloc(n);
+    int32_t hdr[4] = {t, state, 0, 0};
+    memcpy(msg, hdr, sizeof hdr);
+    if (state)
+        tile_state(j, t, msg + 16, 1);
+    murk_mpi_post(to, MURK_TAG_TILE, msg, n);
+    (*remote)++;
+    j->mpi_tiles++;
+    j->mpi_bytes += n;
+}
+
+/* CPU seconds of the calling thread (the overhead measurements: not inflated by preemption). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void nap(void)
+{
+    struct timespec ts = {0, 200 * 1000};
+    nanosleep(&ts, NULL);
+}
+
+/* Rank 0's main thread during a pass: serves the other ranks' requests and results, draws the progress
+ * bar, and returns when every tile is done (or, once stopped, back) and every rank has been answered. */
+static void serve_pass(job *j, int progress, double t_start, int spp_total, int spp_before)
+{
+    int waiting = murk_mpi_size() - 1, remote = 0, stopped = 0;
+    size_t cap = 16 + TILE_BYTES;
+    unsigned char *buf = murk_xmalloc(cap);
+    double drawn = 0;
+    for (;;) {
+        int from, tag, busy = 0;
+        size_t n;
+        while (murk_mpi_poll(-1, &from, &tag, &n)) {
+            double t_msg = thread_cpu();
+            busy = 1;
+            j->mpi_msgs++;
+            j->mpi_bytes += n;
+            if (n > cap)
+                buf = murk_xrealloc(buf, cap = n);
+            murk_mpi_recv(from, tag, buf, n);
+            int32_t k = 1;
+            if (tag == MURK_TAG_REQ) {
+                memcpy(&k, buf, sizeof k);
+                waiting--;
+            } else if (tag == MURK_TAG_RESULT) {
+                int32_t t;
+                memcpy(&t, buf, sizeof t);
+                tile_state(j, t, buf + 8, -1);
+                remote--;
+                atomic_fetch_add(&j->done, 1);
+            }
+            for (; k > 0; k--)
+                hand_out(j, from, stopped, &remote);
+            j->mpi_serve += thread_cpu() - t_msg;
+        }
+        if (!stopped && j->stop && *j->stop) {
+            stopped = 1;
+            if (atomic_load(&j->next) < j->ntiles)
+                atomic_store(&j->abandoned, 1);
+        }
+        if (waiting == 0 && remote == 0 && (stopped || atomic_load(&j->done) >= j->ntiles))
+            break;
+        if (progress && murk_now() - drawn > 0.2) {
+            drawn = murk_now();
+            progress_bar(((double)spp_before + (double)(j->spp1 - j->spp0) * atomic_load(&j->done) / j->ntiles) /
+                         (double)spp_total, drawn - t_start);
+        }
+        if (!busy)
+            nap();
+    }
+    free(buf);
+    murk_mpi_flush();
+}
+
+/* The main thread of a rank other than 0 during a pass: asks for `ask` tiles, queues the tiles that
+ * come for its render threads, returns each rendered tile (which asks for the next) and returns when
+ * every request has been answered and every tile it got is back. */
+static void work_pass(job *j, int ask)
+{
+    int32_t *req = murk_xmalloc(sizeof *req);
+    *req = ask;
+    murk_mpi_post(0, MURK_TAG_REQ, req, sizeof *req);
+    int asked = ask, held = 0;
+    unsigned char *buf = murk_xmalloc(16 + TILE_BYTES);
+    for (;;) {
+        int from, tag, t, busy = 0;
+        size_t n;
+        while (murk_mpi_poll(0, &from, &tag, &n)) {
+            busy = 1;
+            murk_mpi_recv(0, tag, buf, n > 16 + TILE_BYTES ? 16 + TILE_BYTES : n);
+            asked--;
+            if (tag == MURK_TAG_TILE) {
+                int32_t hdr[4];
+                memcpy(hdr, buf, sizeof hdr);
+                tile_state(j, hdr[0], buf + 16, hdr[1] ? -1 : 0);
+                held++;
+                queue_push(j->inq, hdr[0]);
+            }
+        }
+        while ((t = queue_pop(j->outq, 0)) >= 0) {
+            busy = 1;
+            unsigned char *msg = murk_xmalloc(8 + TILE_BYTES);
+            int32_t hdr[2] = {t, 0};
+            memcpy(msg, hdr, sizeof hdr);
+            tile_state(j, t, msg + 8, 1);
+            murk_mpi_post(0, MURK_TAG_RESULT, msg, 8 + TILE_BYTES);
+            held--;
+            asked++;
+        }
+        if (asked == 0 && held == 0)
+            break;
+        if (!busy)
+            nap();
+    }
+    free(buf);
+    queue_close(j->inq);
+    murk_mpi_flush();
+}
+
+/* Renders samples [spp0, spp1) of every pixel on nthreads threads (under MPI: of this rank). */
+static void run_pass(job *j, int nthreads, int progress, double t_start, int spp_total, int spp_before)
 {
     atomic_store(&j->next, 0);
     atomic_store(&j->done, 0);
     atomic_store(&j->abandoned, 0);
+    if (j->inq) {
+        j->inq->head = j->inq->tail = j->inq->closed = 0;
+        j->outq->head = j->outq->tail = 0;
+    }
     pthread_t *th = murk_xmalloc((size_t)nthreads * sizeof *th);
     int started = 0;
     for (; started < nthreads; started++)
         if (pthread_create(&th[started], NULL, worker, j) != 0)
             break;
+    if (started == 0 && murk_mpi_size() > 1) {
+        fprintf(stderr, "murk: rank %d (%s): cannot start a render thread\n", murk_mpi_rank(), murk_mpi_host());
+        murk_mpi_abort(1);
+    }
     if (started == 0) {
         free(th);
         worker(j); /* no threads to be had: render here */
-    } else {
+        return;
+    }
+    if (j->inq)
+        work_pass(j, started + 1);
+    else if (murk_mpi_size() > 1)
+        serve_pass(j, progress, t_start, spp_total, spp_before);
+    else
         while (progress && atomic_load(&j->done) < j->ntiles && !(j->stop && *j->stop)) {
             double frac = ((double)spp_before + (double)(j->spp1 - j->spp0) * atomic_load(&j->done) / j->ntiles) /
                           (double)spp_total;
@@ -134,11 +421,9 @@ static int run_pass(job *j, int nthreads, int progress, double t_start, int spp_
             struct timespec ts = {0, 200 * 1000 * 1000};
             nanosleep(&ts, NULL);
         }
-        for (int i = 0; i < started; i++)
-            pthread_join(th[i], NULL);
-        free(th);
-    }
-    return 0;
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    free(th);
 }
 
 /* Saves the state after `done` whole samples per pixel; 0 or -1 with err set. */
@@ -158,9 +443,81 @@ MURK_API int murk_render(const murk_scene *s, const murk_render_opts *opts, murk
 }
 
 /* Passes: with a time limit, stop signal or checkpoint, passes are sized to take about PASS_SECONDS (the
- * loss when a pass is abandoned, the granularity of checkpoints); otherwise one pass does every sample.
+ * loss when a pass is abandoned, the granularity of checkpoints), MPI_PASS_SECONDS under MPI, where every
+ * pass moves every tile's state twice; otherwise one pass does every sample.
  * Only whole passes count: a pass abandoned on a stop is rolled back from the copy taken before it. */
 #define PASS_SECONDS 0.5
+#define MPI_PASS_SECONDS 2.0
+
+MURK_API int murk_part_of(int w, int x, int y, int parts)
+{
+    int tiles_x = (w + TILE - 1) / TILE;
+    return parts > 0 ? ((y / TILE) * tiles_x + x / TILE) % parts : 0;
+}
+
+MURK_API int murk_part_tiles(int w, int h, int part, int parts)
+{
+    int n = ((w + TILE - 1) / TILE) * ((h + TILE - 1) / TILE);
+    return parts > 0 ? n / parts + (part < n % parts) : n;
+}
+
+/* What rank 0 sends every rank before each pass and at the end (cmd PASS_END: spp0 = the spp reached,
+ * spp1 = interrupted; PASS_FAIL: rank 0 failed before rendering). */
+typedef struct pass_msg {
+    int32_t cmd, spp0, spp1, pad;
+} pass_msg;
+enum { PASS_RUN = 1, PASS_END, PASS_FAIL };
+
+static void send_passes(int cmd, int spp0, int spp1)
+{
+    pass_msg pm = {cmd, spp0, spp1, 0};
+    if (murk_mpi_size() > 1)
+        murk_mpi_bcast(&pm, sizeof pm);
+}
+
+/* Collective at the end: the render threads, cost counters and largest sample of every rank into rank 0's
+ * out and j. */
+static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
+{
+    enum { N = 1 + MURK_COUNTER_SLOTS * MURK_NCOUNTERS };
+    uint64_t v[N];
+    _Static_assert(sizeof j->media == MURK_COUNTER_SLOTS * MURK_NCOUNTERS * sizeof(uint64_t), "counters are uint64s");
+    v[0] = (uint64_t)nthreads;
+    memcpy(v + 1, j->media, sizeof j->media);
+    murk_mpi_sum_u64(v, N);
+    out->threads = (int)v[0];
+    memcpy(j->media, v + 1, sizeof j->media);
+    murk_mpi_max_double(&j->max_sample);
+}
+
+/* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end. */
+static int follow_passes(job *j, int nthreads, murk_render_result *out)
+{
+    tile_queue inq, outq;
+    queue_init(&inq, j->ntiles);
+    queue_init(&outq, j->ntiles);
+    j->inq = &inq, j->outq = &outq, j->stop = NULL;
+    pass_msg pm;
+    for (;;) {
+        murk_mpi_bcast(&pm, sizeof pm);
+        if (pm.cmd != PASS_RUN)
+            break;
+        j->spp0 = pm.spp0, j->spp1 = pm.spp1;
+        atomic_store(&j->rays, 0);
+        atomic_store(&j->nonfinite, 0);
+        atomic_store(&j->busy_ns, 0);
+        run_pass(j, nthreads, 0, 0, 1, 0);
+        uint64_t v[3] = {atomic_load(&j->rays), atomic_load(&j->nonfinite), atomic_load(&j->busy_ns)};
+        murk_mpi_sum_u64(v, 3);
+    }
+    queue_free(&inq);
+    queue_free(&outq);
+    if (pm.cmd == PASS_END)
+        sum_over_ranks(j, nthreads, out);
+    out->spp = pm.spp0;
+    out->interrupted = pm.spp1;
+    return pm.cmd == PASS_END ? 0 : -1;
+}
 
 MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, murk_render_result *out, char *err,
                              size_t errlen)
@@ -181,14 +538,39 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     j.sum = murk_xmalloc(3 * npix * sizeof(double));
     j.count = murk_xmalloc(npix * sizeof(uint32_t));
     j.tiles_x = (s->width + TILE - 1) / TILE;
-    j.ntiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
+    int alltiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
+    int *tiles = murk_xmalloc((size_t)alltiles * sizeof *tiles);
+    size_t npix_rendered = 0;
+    for (int t = 0; t < alltiles; t++)
+        if (murk_part_of(s->width, (t % j.tiles_x) * TILE, (t / j.tiles_x) * TILE, opts->parts) == opts->part) {
+            int x0, y0, x1, y1;
+            tiles[j.ntiles++] = t;
+            tile_rect(&j, t, &x0, &y0, &x1, &y1);
+            npix_rendered += (size_t)(x1 - x0) * (size_t)(y1 - y0);
+        }
+    j.tiles = tiles;
     j.stop = opts->stop;
     atomic_init(&j.rays, 0);
     atomic_init(&j.nonfinite, 0);
+    atomic_init(&j.busy_ns, 0);
     atomic_init(&j.abandoned, 0);
+    pthread_mutex_init(&j.lock, NULL);
+    j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
+    out->width = s->width;
+    out->height = s->height;
+    out->ranks = murk_mpi_size();
+    if (murk_mpi_rank() > 0) {
+        int rc = follow_passes(&j, nthreads, out);
+        pthread_mutex_destroy(&j.lock);
+        free(j.sum);
+        free(j.count);
+        free(tiles);
+        return rc;
+    }
     /* Hidden, for bench/stability/atlas.py: MURK_SAMPLE_DUMP=FILE writes every sample's RGB as float32
      * [pixel][sample][r, g, b] (pixels row by row) after the render, for per-sample statistics (firefly
-     * rate, largest sample, non-finite count). Up to 2^26 samples; not with --resume. */
+     * rate, largest sample, non-finite count). Up to 2^26 samples; not with --resume; under MPI, rank 0's
+     * tiles only. */
     const char *dump_path = getenv("MURK_SAMPLE_DUMP");
     if (dump_path && *dump_path && !opts->resume && spp > 0 && npix * (size_t)spp <= ((size_t)1 << 26)) {
         j.dump = calloc(3 * npix * (size_t)spp, sizeof(float));
@@ -200,17 +582,16 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     if (opts->resume) {
         murk_ckpt want = {.scene_hash = opts->scene_hash, .seed = s->seed, .width = s->width, .height = s->height,
                           .overrides = opts->overrides}, c;
-        if (murk_ckpt_load(opts->resume, &want, &c, err, errlen) != 0) {
-            free(j.sum);
-            free(j.count);
-            return -1;
-        }
-        if (c.spp > spp) {
+        if (murk_ckpt_load(opts->resume, &want, &c, err, errlen) == 0 && c.spp > spp) {
             murk_err_file(err, errlen, opts->resume, "the checkpoint has %d spp, more than the %d asked for", c.spp,
                           spp);
             murk_ckpt_free(&c);
+        }
+        if (err[0]) {
+            send_passes(PASS_FAIL, 0, 0);
             free(j.sum);
             free(j.count);
+            free(tiles);
             return -1;
         }
         memcpy(j.sum, c.sum, 3 * npix * sizeof(double));
@@ -239,7 +620,16 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
             memcpy(keep_count, j.count, npix * sizeof(uint32_t));
         }
         double tp = murk_now();
+        send_passes(PASS_RUN, j.spp0, j.spp1);
+        j.mpi_passes++;
         run_pass(&j, nthreads, opts->progress, t0, spp - start, done - start);
+        if (murk_mpi_size() > 1) { /* the other ranks' rays, NaNs and busy time of this pass */
+            uint64_t v[3] = {0, 0, 0};
+            murk_mpi_sum_u64(v, 3);
+            atomic_fetch_add(&j.rays, v[0]);
+            atomic_fetch_add(&j.nonfinite, v[1]);
+            atomic_fetch_add(&j.busy_ns, v[2]);
+        }
         if (atomic_load(&j.abandoned)) { /* roll the partial pass back: only whole passes count */
             memcpy(j.sum, keep_sum, 3 * npix * sizeof(double));
             memcpy(j.count, keep_count, npix * sizeof(uint32_t));
@@ -266,7 +656,7 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
                 break;
             pass = (int)(left / per_spp * 0.9); /* next pass fills most of what is left */
         } else if (adaptive) {
-            pass = (int)(PASS_SECONDS / (per_spp > 1e-9 ? per_spp : 1e-9));
+            pass = (int)((murk_mpi_size() > 1 ? MPI_PASS_SECONDS : PASS_SECONDS) / (per_spp > 1e-9 ? per_spp : 1e-9));
         }
         if (pass < 1)
             pass = 1;
@@ -274,6 +664,8 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
             pass = 2 * n + 1; /* grow gradually so the estimate can adapt */
     }
     out->interrupted = done < spp && opts->stop && *opts->stop;
+    send_passes(PASS_END, done, out->interrupted);
+    sum_over_ranks(&j, nthreads, out);
     if (rc == 0 && opts->checkpoint && save_checkpoint(s, opts, &j, done, err, errlen) != 0)
         rc = -1;
     free(keep_sum);
@@ -282,17 +674,26 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
         progress_bar((double)(done - start) / (spp - start > 0 ? spp - start : 1), murk_now() - t0);
         fputc('\n', stderr);
     }
+    if (murk_mpi_size() > 1 && getenv("MURK_MPI_STATS")) /* the measured overheads bench/scaling.py models */
+        fprintf(stderr, "murk: mpi: %d ranks, %llu passes, %d tiles per pass, %llu tiles to other ranks, %llu "
+                "messages, %llu bytes, rank 0 handled them in %.6f CPU s (%.2f us per tile)\n", murk_mpi_size(),
+                (unsigned long long)j.mpi_passes, j.ntiles, (unsigned long long)j.mpi_tiles,
+                (unsigned long long)j.mpi_msgs, (unsigned long long)j.mpi_bytes, j.mpi_serve,
+                j.mpi_tiles ? 1e6 * j.mpi_serve / (double)j.mpi_tiles : 0.0);
     out->seconds = murk_now() - t0;
-    out->width = s->width;
-    out->height = s->height;
     out->spp = done;
+    out->thread_seconds = (double)atomic_load(&j.busy_ns) * 1e-9;
     out->rgb = murk_xmalloc(3 * npix * sizeof(float));
     for (size_t i = 0; i < npix; i++)
         for (int c = 0; c < 3; c++)
             out->rgb[3 * i + (size_t)c] = j.count[i] ? (float)(j.sum[3 * i + (size_t)c] / j.count[i]) : 0.0f;
-    out->samples = (uint64_t)(done - start) * npix;
+    out->samples = (uint64_t)(done - start) * npix_rendered;
     out->rays = atomic_load(&j.rays) - rays_before;
     out->nonfinite = atomic_load(&j.nonfinite);
+    out->nmedia = (int)j.nslots;
+    out->max_sample = j.max_sample;
+    memcpy(out->media, j.media, sizeof j.media);
+    pthread_mutex_destroy(&j.lock);
     if (j.dump) {
         FILE *f = fopen(dump_path, "wb");
         if (!f || fwrite(j.dump, sizeof(float), 3 * npix * (size_t)spp, f) != 3 * npix * (size_t)spp)
@@ -303,5 +704,6 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     }
     free(j.sum);
     free(j.count);
+    free(tiles);
     return rc;
 }

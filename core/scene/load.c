@@ -30,11 +30,12 @@ static murk_rgb to_rgb(const double d[3]) { return murk_rgb3((float)d[0], (float
 
 static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
 {
-    static const char *const keys[] = {"resolution", "spp", "seed", "exposure"};
+    static const char *const keys[] = {"resolution", "spp", "seed", "exposure", "sampler"};
     s->width = s->height = 512;
     s->spp = 64;
     s->seed = 0;
     s->exposure = 0.0f;
+    s->sampler = MURK_SAMPLER_SOBOL;
     if (!n)
         return 0;
     if (murk_yexpect_map(n, "render", err, errlen) || murk_ycheck_keys(n, "render", keys, NKEYS(keys), err, errlen))
@@ -68,6 +69,19 @@ static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t err
         if (murk_yread_range(c, "render.exposure", -30, 30, &e, err, errlen))
             return -1;
         s->exposure = (float)e;
+    }
+    if ((c = murk_ymap_get(n, "sampler"))) {
+        static const char *const samplers[] = {"independent", "sobol"}; /* indexed by MURK_SAMPLER_* */
+        const char *v;
+        long k = -1;
+        if (murk_yread_string(c, "render.sampler", &v, err, errlen))
+            return -1;
+        for (size_t i = 0; i < NKEYS(samplers); i++)
+            if (strcmp(v, samplers[i]) == 0)
+                k = (long)i;
+        if (k < 0)
+            return ERR(c, "render.sampler must be one of sobol|independent, got '%s'", v);
+        s->sampler = (uint32_t)k;
     }
     return 0;
 }

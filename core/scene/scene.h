@@ -37,6 +37,11 @@ typedef struct murk_light {
     float radius, area;
     float pmf; /* probability of picking this light */
     murk_rgb le;
+    /* a triangle of a rectangle (a quad or box face: two triangles): the rectangle p0 + a ex + b ey,
+     * a, b in [0, 1], and the probability of picking either of its triangles (MURK_LIGHT_SOLID_ANGLE) */
+    int rect;
+    murk_vec3 rp0, rex, rey;
+    float rect_pmf;
 } murk_light;
 
 typedef struct murk_named_material { char *name; murk_material m; const murk_plugin *plugin; } murk_named_material;
@@ -58,6 +63,7 @@ struct murk_scene {
     int width, height, spp;
     uint64_t seed;
     float exposure;
+    uint32_t sampler; /* MURK_SAMPLER_* (render.sampler) */
     /* camera */
     murk_vec3 cam_from, cam_at, cam_up;
     float fov;

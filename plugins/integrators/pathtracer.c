@@ -22,6 +22,10 @@ const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
                            "most scattering events (surface or medium) per path"},
     [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000,
                           "scattering events before Russian roulette may end a path"},
+    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0,
+                                "NEE: every light triangle by area, or rectangular lights by solid angle"},
+    [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1,
+                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -54,6 +58,8 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->host = host;
     pt->max_depth = (int)params[MURK_PT_MAX_DEPTH].f[0];
     pt->rr_depth = (int)params[MURK_PT_RR_DEPTH].f[0];
+    pt->light_strategy = params[MURK_PT_LIGHT_SAMPLING].choice == 1 ? MURK_LIGHT_SOLID_ANGLE : MURK_LIGHT_AREA;
+    pt->rr_threshold = (float)params[MURK_PT_RR_THRESHOLD].f[0];
     pt->nee = nee;
     pt->media = media;
     *self = pt;
@@ -66,6 +72,17 @@ void murk_pt_destroy(void *self)
     if (pt)
         pt->host->free(pt);
 }
+
+/* The sampler's slots (murk/math.h), in this order in every sample: 0 the camera jitter (the core),
+ * 1 the hero channel, then per scattering event d = 0, 1, ... (a surface or a medium vertex) five
+ * slots from PT_SLOT(d, 0): the light choice (1-D) and the point on the light (2-D) of NEE, the
+ * BSDF / phase direction (2-D), the BSDF's lobe choice (1-D, u[2] of a material's sample()) and the
+ * Russian roulette after the event (1-D). Trackers and transmittance estimators take their numbers
+ * from the PCG stream (murk_rng_float), outside the slots. */
+enum { PT_SLOT_HERO = 1 };
+enum { PT_SLOT_LIGHT_CHOICE, PT_SLOT_LIGHT_POINT, PT_SLOT_DIRECTION, PT_SLOT_LOBE, PT_SLOT_ROULETTE,
+       PT_SLOTS_PER_EVENT };
+#define PT_SLOT(depth, which) (2u + (uint32_t)(depth) * PT_SLOTS_PER_EVENT + (uint32_t)(which))
 
 /* ---- small helpers ------------------------------------------------------------------------- */
 
@@ -222,9 +239,12 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, murk_rng *rng)
 {
     const murk_host *h = pt->host;
-    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    float u[3];
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE));
+    u[0] = murk_sample_1d(rng);
+    murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
-    if (!h->sample_light(scene, v->p, u, &ls))
+    if (!h->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
         return;
     murk_rgb f = vertex_f(h, v, ls.wi);
     if (!finite3(f)) {
@@ -279,7 +299,9 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     v.g = m->data->g;
     if (pt->nee)
         sample_light(pt, scene, st, &v, rng);
-    float u[2] = {murk_rng_float(rng), murk_rng_float(rng)}, pdf;
+    float u[2], pdf;
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
+    murk_sample_2d(rng, u);
     murk_vec3 wi = h->phase_sample(v.g, v.wo, u, &pdf);
     if (!(pdf > 0.0f))
         return PT_END;
@@ -300,7 +322,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     murk_vec3 wo = murk_neg(st->ray.d);
     murk_rgb le = murk_hit_le(hit, wo);
     if (!murk_rgb_is_black(le))
-        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf(scene, st->prev_p, hit))
+        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy))
                                                      : 1.0f);
     if (st->depth >= pt->max_depth)
         return 0;
@@ -324,7 +346,10 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         v.wo_local.z = 1e-6f;
     if (pt->nee)
         sample_light(pt, scene, st, &v, rng);
-    float u[3] = {murk_rng_float(rng), murk_rng_float(rng), murk_rng_float(rng)};
+    float u[3];
+    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
+    murk_sample_2d(rng, u);
+    u[2] = murk_sample_1d(rng); /* PT_SLOT_LOBE */
     murk_bsdf_sample bs;
     bs.eta = 1.0f; /* a material built before ABI 1.3 does not write it */
     if (!v.mat->vt->sample(v.mat->self, v.hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
@@ -362,16 +387,21 @@ static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
     return 1;
 }
 
-/* After rr_depth events a path survives with probability q = max_c |beta_c| eta_scale / mean(R) (at
- * least 0.05, at most 1) and is divided by it (eta_scale: a path inside glass is not culled for the
- * 1 / eta^2 its radiance weight carries there). Returns 0 when the path ends. */
+/* After rr_depth events a path survives with probability q = max_c |beta_c| eta_scale / mean(R) /
+ * rr_threshold (at least 0.05, at most 1) and is divided by it (eta_scale: a path inside glass is not
+ * culled for the 1 / eta^2 its radiance weight carries there). rr_threshold 1 plays roulette with every
+ * path whose weight fell below 1; 0.1 (Tungsten's rule) only with the paths below a tenth. Returns 0 when
+ * the path ends. */
 static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
 {
     if (st->depth > pt->rr_depth) {
         murk_rgb b = st->beta;
         float q = murk_maxf(fabsf(b.c[0]), murk_maxf(fabsf(b.c[1]), fabsf(b.c[2]))) * st->eta_scale / mean3(st->R);
+        if (pt->rr_threshold > 0.0f)
+            q /= pt->rr_threshold;
         q = murk_maxf(0.05f, murk_minf(1.0f, q));
-        if (murk_rng_float(rng) >= q)
+        murk_sample_seek(rng, PT_SLOT(st->depth - 1, PT_SLOT_ROULETTE)); /* depth was counted up at the vertex */
+        if (murk_sample_1d(rng) >= q)
             return 0;
         st->beta = murk_rgb_scale(st->beta, 1.0f / q);
     }
@@ -385,7 +415,8 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
     path st = {0};
     st.beta = st.R = murk_rgb1(1.0f);
     st.eta_scale = 1.0f;
-    st.ctx.hero = (int)(murk_rng_float(rng) * 3.0f);
+    murk_sample_seek(rng, PT_SLOT_HERO);
+    st.ctx.hero = (int)(murk_sample_1d(rng) * 3.0f);
     if (st.ctx.hero > 2)
         st.ctx.hero = 2;
     st.medium = pt->media ? h->camera_medium(scene) : NULL;

@@ -26,7 +26,8 @@
  * only and sum to 1). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
  * independent estimator of the same image. With media = 0 (`path`) media are ignored and boundaries
  * passed straight through, by paths and shadow rays alike. Russian roulette after rr_depth events on
- * the path's largest channel weight over mean(R); survivors are divided by the survival probability. */
+ * the path's largest channel weight over mean(R), relative to rr_threshold; survivors are divided by
+ * the survival probability. */
 #ifndef MURK_PATHTRACER_H
 #define MURK_PATHTRACER_H
 
@@ -34,7 +35,7 @@
 #include "murk/medium.h"
 
 /* The parameters all three integrators share (documented in each plugin's comment block). */
-enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_NPARAMS };
+enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 
 typedef struct murk_pt {
@@ -42,6 +43,8 @@ typedef struct murk_pt {
     int max_depth, rr_depth;
     int nee;   /* sample lights at every scattering vertex */
     int media; /* track media (0: surfaces only, boundaries are invisible) */
+    int light_strategy; /* MURK_LIGHT_* for NEE and the MIS weight of emission found (0: area, the default) */
+    float rr_threshold; /* Russian roulette's survival probability is min(1, weight / rr_threshold) (0: 1) */
 } murk_pt;
 
 /* create() for an integrator with the given strategy; destroy() for all of them. */

@@ -91,6 +91,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
         return;
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin, cscale = 1.0f, boost = 1.0f;
@@ -115,6 +116,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             float tr = mu_r > 0.0f ? murk_advance(t, murk_sample_exp(rng, mu_r)) : INFINITY;
             if (!(tc < tb) && !(tr < tb))
                 break;
+            count->collisions++; /* a control or a residual collision */
             if (tc <= tr) { /* control collision */
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= st.c[k] > 0.0f ? d->sigma_s.c[k] / st.c[k] : 0.0f;

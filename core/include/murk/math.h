@@ -71,10 +71,35 @@ static inline float murk_luminance(murk_rgb a) { return 0.2126f * a.c[0] + 0.715
 static inline int murk_rgb_is_black(murk_rgb a) { return a.c[0] == 0.0f && a.c[1] == 0.0f && a.c[2] == 0.0f; }
 static inline int murk_rgb_finite(murk_rgb a) { return isfinite(a.c[0]) && isfinite(a.c[1]) && isfinite(a.c[2]); }
 
-/* ---- Random numbers -------------------------------------------------------------------------
+/* ---- Random numbers and the sampler ----------------------------------------------------------
  * murk_rng is PCG32 (O'Neill 2014). The core seeds one stream per (seed, pixel, sample) by hashing
- * those counters, so a sample's numbers never depend on which thread ran it or in which order. */
-typedef struct murk_rng { uint64_t state, inc; } murk_rng;
+ * those counters, so a sample's numbers never depend on which thread ran it or in which order.
+ *
+ * ABI 1.4 appends the sampler: murk_sample_1d/2d() draw the integrator's dimensions, one *slot* per
+ * call (a 2-D slot gives a point, a 1-D slot its first coordinate). With MURK_SAMPLER_SOBOL slot s
+ * of sample i of a pixel is the point i of a padded Owen-scrambled Sobol sequence (Burley 2020):
+ * Sobol dimensions 0 and 1 of a shuffled index, the shuffle and both scrambles hashed from (seed,
+ * pixel, s). So the first 2^k samples of every slot are stratified (one point per elementary interval
+ * of area 2^-k), slots are independent of one another (padding: any number of them), and sample i is a
+ * function of (seed, pixel, i) alone: any range of samples [a, b) is the same points whichever pass,
+ * thread or tile renders it. murk_sample_seek() sets the next slot, so that a decision takes the same
+ * slot in every sample (the integrators' slot order is documented in docs/plugins.md). With
+ * MURK_SAMPLER_INDEPENDENT (and in an rng that murk_rng_seed() made) the same calls draw
+ * murk_rng_float() in call order. murk_rng_float() always draws from the PCG stream, which the sampler
+ * never touches: code with unbounded use of numbers (a tracker's collision loop) takes them there
+ * without shifting the integrator's slots. Only the core creates the murk_rng it passes to plugins, so a
+ * plugin built against ABI 1.3 (which knows state and inc only) still works unchanged. */
+enum { MURK_SAMPLER_INDEPENDENT = 0, MURK_SAMPLER_SOBOL = 1 };
+
+typedef struct murk_rng {
+    uint64_t state, inc;
+    /* ABI 1.4 */
+    uint64_t scramble; /* hash of (seed, pixel): the sampler's per-pixel decorrelation */
+    uint32_t sampler;  /* MURK_SAMPLER_* */
+    uint32_t index;    /* the sample's index within its pixel */
+    uint32_t dim;      /* the next slot */
+    uint32_t rindex;   /* index with its bits reversed */
+} murk_rng;
 
 static inline uint64_t murk_hash64(uint64_t x)
 { /* splitmix64 finaliser */
@@ -99,8 +124,86 @@ static inline void murk_rng_seed(murk_rng *r, uint64_t a, uint64_t b, uint64_t c
     murk_rng_u32(r);
     r->state += h;
     murk_rng_u32(r);
+    r->scramble = 0u;
+    r->sampler = MURK_SAMPLER_INDEPENDENT;
+    r->index = r->dim = r->rindex = 0u;
 }
 /* Uniform float in [0, 1): 24 random mantissa bits, never 1. */
 static inline float murk_rng_float(murk_rng *r) { return (float)(murk_rng_u32(r) >> 8) * (1.0f / 16777216.0f); }
+
+static inline uint32_t murk_reverse_bits32(uint32_t x)
+{
+    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
+    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
+    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/* The stream of sample `index` of pixel `pixel` for a render seeded with `seed`, drawing its slots
+ * with `sampler` (MURK_SAMPLER_*) from slot 0. What the core does before every sample. */
+static inline void murk_sampler_start(murk_rng *r, uint32_t sampler, uint64_t seed, uint64_t pixel, uint32_t index)
+{
+    murk_rng_seed(r, seed, pixel, index);
+    r->scramble = murk_hash64(murk_hash64(seed ^ 0x5851f42d4c957f2dull) ^ pixel);
+    r->sampler = sampler;
+    r->index = index;
+    r->rindex = murk_reverse_bits32(index);
+}
+static inline void murk_sample_seek(murk_rng *r, uint32_t slot) { r->dim = slot; }
+
+/* Sobol dimension 1 is Pascal's matrix mod 2: output bit j (from the top) is the XOR of the index bits
+ * k (from the bottom) with j a subset of k (Lucas). That is a superset-sum over the 5-bit positions,
+ * five shift-xor steps; the result has output bit j at position j, i.e. it is reversed. */
+static inline uint32_t murk_sobol1_reversed(uint32_t i)
+{
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
+}
+/* A nested uniform (Owen) scramble of the bits of x, most significant first, is reverse(lk(reverse(x))):
+ * lk flips each bit by a hash of the bits below it (Laine-Karras style, Vegdahl's constants). */
+static inline uint32_t murk_lk_hash_(uint32_t x, uint32_t seed)
+{
+    x ^= x * 0x3d20adeau;
+    x += seed;
+    x *= (seed >> 16) | 1u;
+    x ^= x * 0x05526c56u;
+    x ^= x * 0x53a22864u;
+    return x;
+}
+/* The next slot's shuffled sample index i (an Owen scramble of the index, which keeps every block of
+ * 2^k consecutive indices a (0, k, 2)-net) and its scrambled Sobol coordinate 0; *h gets the slot's
+ * hash. owen(sobol0(i)) = reverse(lk(i)) since sobol0 is the bit reversal. */
+static inline uint32_t murk_sample_slot_(murk_rng *r, uint32_t *i, uint64_t *h)
+{
+    *h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(r->dim++ + 1u));
+    *i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)*h));
+    return murk_reverse_bits32(murk_lk_hash_(*i, (uint32_t)(*h >> 32)));
+}
+static inline float murk_u24_(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+/* The next slot as a point in [0, 1)^2 (24 bits each, never 1). */
+static inline void murk_sample_2d(murk_rng *r, float u[2])
+{
+    if (r->sampler != MURK_SAMPLER_SOBOL) {
+        u[0] = murk_rng_float(r);
+        u[1] = murk_rng_float(r);
+        return;
+    }
+    uint32_t i;
+    uint64_t h;
+    u[0] = murk_u24_(murk_sample_slot_(r, &i, &h));
+    u[1] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_sobol1_reversed(i), (uint32_t)murk_hash64(h))));
+}
+/* The next slot as one number in [0, 1). */
+static inline float murk_sample_1d(murk_rng *r)
+{
+    uint32_t i;
+    uint64_t h;
+    return r->sampler != MURK_SAMPLER_SOBOL ? murk_rng_float(r) : murk_u24_(murk_sample_slot_(r, &i, &h));
+}
 
 #endif

@@ -7,6 +7,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "murk/counters.h"
+
 typedef struct murk_scene murk_scene;
 
 typedef struct murk_render_opts {
@@ -24,15 +26,27 @@ typedef struct murk_render_opts {
     const char *resume;          /* continue from this checkpoint (same scene, overrides, seed, size) */
     uint64_t scene_hash;         /* identify the scene in a checkpoint: its content hash ... */
     const char *overrides;       /* ... and its --set overrides (NULL = none) */
+    /* A share of the image (murk render --part I/N): with parts > 0 only the 16x16 tiles t (row-major)
+     * with t % parts == part are rendered; the other pixels stay 0. */
+    int part, parts;
 } murk_render_opts;
 
 typedef struct murk_render_result {
     int width, height, spp; /* spp actually rendered */
-    float *rgb;             /* 3*width*height linear floats, row 0 at the top; free() it */
+    float *rgb;             /* 3*width*height linear floats, row 0 at the top; free() it (NULL on MPI ranks
+                               other than 0: rank 0 gets the image) */
     double seconds;
     uint64_t samples, rays, nonfinite; /* samples and rays: this run's; nonfinite: the image's (resumed too) */
     int interrupted;        /* opts->stop was set before spp was reached */
     int resumed_spp;        /* spp taken from opts->resume */
+    /* This run's cost counters per medium, in the scene's order (murk/counters.h): nmedia blocks, the
+     * last one shared when the scene has more than MURK_COUNTER_SLOTS media. */
+    int nmedia;
+    murk_counters media[MURK_COUNTER_SLOTS];
+    double max_sample; /* the largest channel value of a finite sample (this run's): a sign of fireflies */
+    /* The job (summed over MPI ranks): processes, render threads, seconds those threads spent in tiles. */
+    int ranks, threads;
+    double thread_seconds;
 } murk_render_result;
 
 /* `sets` are "KEY.PATH=VALUE" overrides. NULL with a one-line "file:line:col: message" in err. */
@@ -43,6 +57,10 @@ void murk_scene_free(murk_scene *scene);
 int murk_render(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out);
 int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out, char *err,
                     size_t errlen);
+/* --part I/N: the 16x16 tile (numbered row-major) that holds pixel (x, y) of a w x h image belongs to
+ * part tile % parts; murk_part_tiles counts the tiles of one part. */
+int murk_part_of(int w, int x, int y, int parts);
+int murk_part_tiles(int w, int h, int part, int parts);
 /* FNV-1a 64 of a file's bytes (a scene's content hash for checkpoints); 0 with err set if unreadable. */
 uint64_t murk_file_hash(const char *path, char *err, size_t errlen);
 

@@ -23,7 +23,9 @@
  * host->size before calling a host service appended after 1.0.
  * History: 1.0 the first stable ABI; 1.1 appends murk_plugin_desc.version; 1.2 adds the transmittance
  * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
- * (the hit a material gets has n on wo's side, murk/material.h). Anything else — a changed signature,
+ * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
+ * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
+ * host's sample_light_with / light_pdf_with. Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -50,10 +52,11 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "murk/counters.h"
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 3
+#define MURK_ABI_MINOR 4
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
@@ -173,7 +176,21 @@ typedef struct murk_host {
      * scattering, g > 0, favours wi = -wo). phase_eval is also the pdf of phase_sample. */
     float (*phase_eval)(float g, murk_vec3 wo, murk_vec3 wi);
     murk_vec3 (*phase_sample)(float g, murk_vec3 wo, const float u[2], float *pdf);
+    /* ABI 1.4: the calling thread's cost counters for the medium whose density field is d
+     * (murk/counters.h); never NULL. Call it once per flight, not per collision. */
+    murk_counters *(*counters)(const murk_density *d);
+    /* ABI 1.4: sample_light / light_pdf with a strategy (MURK_LIGHT_*). sample_light and light_pdf
+     * are MURK_LIGHT_AREA. */
+    int (*sample_light_with)(const murk_scene *scene, murk_vec3 p, const float u[3], int strategy,
+                             murk_light_sample *ls);
+    float (*light_pdf_with)(const murk_scene *scene, murk_vec3 p, const murk_hit *hit, int strategy);
 } murk_host;
+
+/* Light sampling strategies (ABI 1.4). AREA: a triangle (quads and box faces are two) uniformly by
+ * area, a sphere uniformly in its cone. SOLID_ANGLE: a rectangular quad or box face uniformly in the
+ * solid angle it subtends (spherical rectangles, Urena et al. 2013) where that solid angle is at least
+ * 1e-4 sr (smaller: by area), the rest as AREA. Both choose the light by power. */
+enum { MURK_LIGHT_AREA = 0, MURK_LIGHT_SOLID_ANGLE = 1 };
 
 /* A parameter's value at a hit: the texture if one was given, else the constant. */
 static inline void murk_value_eval(const murk_host *host, const murk_value *v, const murk_hit *hit, float out[3])

@@ -5,7 +5,13 @@
  * estimators, murk/transmittance.h). Header-only; include after murk/medium.h.
  *
  * A tracker that walks the majorant grid itself (host->walk_init / walk_next) and reads the density
- * with host->density() needs nothing else from here; these helpers are what murk's own trackers share. */
+ * with host->density() needs nothing else from here; these helpers are what murk's own trackers share.
+ *
+ * Cost counters (murk/counters.h). The core counts density lookups and majorant cells inside
+ * host->density() and host->walk_next(), so a tracker that walks the grid itself has its lookups and
+ * cells counted with nothing to do; the helpers below count their tentative collisions. A tracker that
+ * draws its own collisions takes murk_tracker_counters() once per flight and adds one to ->collisions
+ * per tentative (null or real) collision (decomposition.c does). */
 #ifndef MURK_TRACKING_H
 #define MURK_TRACKING_H
 
@@ -50,6 +56,14 @@ static inline void murk_tracker_free(void *self)
     murk_tracker *t = self;
     if (t)
         t->host->free(t);
+}
+
+/* The calling thread's counters for medium d (host->counters, once per flight), or *scratch when the
+ * host predates ABI 1.4 or fills no counters (a test's host table): never NULL. */
+static inline murk_counters *murk_tracker_counters(const murk_host *h, const murk_medium_data *d,
+                                                   murk_counters *scratch)
+{
+    return MURK_HAS(h->size, murk_host, counters) && h->counters ? h->counters(d->density) : scratch;
 }
 
 /* An event that passes the whole segment with weight 1 and pdf ratios 1. */
@@ -164,6 +178,7 @@ typedef struct murk_collisions {
     float boost; /* this flight's majorant multiplier, raised where the majorant failed */
     long steps;  /* collisions and cells so far */
     int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
+    murk_counters *count, scratch; /* the medium's cost counters (murk_tracker_counters) */
 } murk_collisions;
 
 static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *tr, const murk_ray *ray, float sigma)
@@ -177,6 +192,7 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->boost = 1.0f;
     c->steps = 0;
     c->stopped = 0;
+    c->count = murk_tracker_counters(tr->host, tr->d, &c->scratch);
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
 }
 
@@ -207,6 +223,7 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
         if (c->mu > 0.0f) {
             c->t = murk_advance(c->t, murk_sample_exp(rng, c->mu));
             if (c->t < c->tb) {
+                c->count->collisions++;
                 *t = c->t;
                 *dens = c->tr->host->density(c->tr->d->density, murk_madd(c->ray->o, c->ray->d, c->t));
                 return 1;
@@ -232,6 +249,7 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
     float smax = murk_rgb_max(st);
     if (!(smax > 0.0f))
         return T;
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin, boost = 1.0f; /* boost: the ray's majorant raise where it failed */
@@ -255,6 +273,7 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
             t = murk_advance(t, murk_sample_exp(rng, mu));
             if (!(t < tb))
                 break;
+            count->collisions++;
             murk_vec3 p = murk_madd(ray->o, ray->d, t);
             float dens = h->density(d->density, p) - c, r = fabsf(dens) * smax / mu;
             for (int k = 0; k < 3; k++)

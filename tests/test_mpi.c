@@ -1,0 +1,173 @@
+/* test_mpi.c — `mpirun -n N murk render` (issue 13, items 1 and 5). A scene with a medium rendered by 1, 2
+ * and 3 ranks is bitwise the single-process render, with the same rays and cost counters (summed over
+ * the ranks); so are a render resumed by 3 ranks from the
+ * checkpoint 2 ranks wrote, and a --time render (rank 0 decides the passes) against a single-process
+ * render of the spp it reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
+ * job with the located message naming that rank, a non-zero status and no image. Skipped (exit 77)
+ * when murk is built without MPI or mpirun is missing. The ranks run on this machine, oversubscribed
+ * (--oversubscribe), as root when need be (OMPI_ALLOW_RUN_AS_ROOT). */
+#include "image.h"
+#include "testutil.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define RES "render.resolution=[80,64]"
+#define SPP "16"
+#define SCENE "scenes/cornell_smoke.yaml"
+
+/* mpirun [ranks] murk render SCENE -o out --set RES --threads 1 --quiet extra... ; its exit status. */
+static int mpi_render(char **log, int ranks, const char *out, const char *const *extra)
+{
+    char n[16];
+    snprintf(n, sizeof n, "%d", ranks);
+    const char *argv[48] = {getenv("MURK_MPIRUN"), "--oversubscribe", "-n", n, getenv("MURK_EXE"), "render",
+                            src_path(SCENE), "-o", tmp_path(out), "--set", RES, "--threads", "1", "--quiet"};
+    int k = 14;
+    for (; extra && *extra; extra++)
+        argv[k++] = *extra;
+    argv[k] = NULL;
+    return run_argv(log, argv);
+}
+
+static const char *meta(const char *path, const char *key)
+{
+    static char val[256];
+    murk_image img = {0};
+    char err[1024];
+    if (murk_exr_read(path, &img, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    const char *v = murk_image_meta(&img, key);
+    snprintf(val, sizeof val, "%s", v ? v : "(none)");
+    murk_image_free(&img);
+    return val;
+}
+
+static void render_single(const char *out, const char *spp)
+{
+    char *log = NULL;
+    const char *args[] = {"render", src_path(SCENE), "-o", tmp_path(out), "--spp", spp, "--set", RES,
+                          "--threads", "2", "--quiet", NULL};
+    int rc = run_murk_argv(&log, args);
+    if (rc != 0)
+        fail_msg("murk render failed (%d):\n%s", rc, log);
+    free(log);
+}
+
+static void ranks_give_the_single_process_image(void **state)
+{
+    (void)state;
+    render_single("single.exr", SPP);
+    for (int ranks = 1; ranks <= 3; ranks++) {
+        char out[32], *log = NULL, want[16];
+        snprintf(out, sizeof out, "ranks%d.exr", ranks);
+        const char *extra[] = {"--spp", SPP, NULL};
+        int rc = mpi_render(&log, ranks, out, extra);
+        if (rc != 0)
+            fail_msg("mpirun -n %d murk render failed (%d):\n%s", ranks, rc, log);
+        free(log);
+        assert_same_pixels(tmp_path(out), tmp_path("single.exr"));
+        snprintf(want, sizeof want, "%d", ranks);
+        assert_string_equal(meta(tmp_path(out), "murk:ranks"), want);
+        assert_string_equal(meta(tmp_path(out), "murk:threads"), want);
+        assert_true(atof(meta(tmp_path(out), "murk:thread_time")) > 0);
+        assert_string_equal(meta(tmp_path(out), "murk:part"), "(none)");
+        char counters[256]; /* rays and cost counters, summed over the ranks, are the single process's */
+        snprintf(counters, sizeof counters, "%s", meta(tmp_path("single.exr"), "murk:counters"));
+        assert_string_equal(meta(tmp_path(out), "murk:counters"), counters);
+    }
+}
+
+static void resumed_by_other_ranks(void **state)
+{
+    (void)state;
+    render_single("single.exr", SPP);
+    char *log = NULL;
+    const char *first[] = {"--spp", "5", "--checkpoint", tmp_path("ck"), NULL};
+    int rc = mpi_render(&log, 2, "five.exr", first);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 (5 spp, checkpoint) failed (%d):\n%s", rc, log);
+    free(log);
+    const char *rest[] = {"--spp", SPP, "--resume", tmp_path("ck"), NULL};
+    rc = mpi_render(&log, 3, "resumed.exr", rest);
+    if (rc != 0)
+        fail_msg("mpirun -n 3 --resume failed (%d):\n%s", rc, log);
+    free(log);
+    assert_same_pixels(tmp_path("resumed.exr"), tmp_path("single.exr"));
+}
+
+static void time_limit_passes_are_rank0s(void **state)
+{
+    (void)state;
+    char *log = NULL, spp[32];
+    const char *extra[] = {"--spp", "100000", "--time", "1.5", NULL};
+    int rc = mpi_render(&log, 2, "timed.exr", extra);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 --time failed (%d):\n%s", rc, log);
+    free(log);
+    snprintf(spp, sizeof spp, "%s", meta(tmp_path("timed.exr"), "murk:spp"));
+    assert_true(atoi(spp) >= 1);
+    render_single("timed_single.exr", spp);
+    assert_same_pixels(tmp_path("timed.exr"), tmp_path("timed_single.exr"));
+}
+
+static void part_rendered_by_ranks(void **state)
+{
+    (void)state;
+    char *log = NULL;
+    const char *args[] = {"render", src_path(SCENE), "-o", tmp_path("part1.exr"), "--spp", SPP, "--set", RES,
+                          "--threads", "2", "--quiet", "--part", "1/3", NULL};
+    int rc = run_murk_argv(&log, args);
+    if (rc != 0)
+        fail_msg("murk render --part 1/3 failed (%d):\n%s", rc, log);
+    free(log);
+    const char *extra[] = {"--spp", SPP, "--part", "1/3", NULL};
+    rc = mpi_render(&log, 2, "part1_mpi.exr", extra);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 murk render --part 1/3 failed (%d):\n%s", rc, log);
+    free(log);
+    assert_same_pixels(tmp_path("part1_mpi.exr"), tmp_path("part1.exr"));
+    assert_string_equal(meta(tmp_path("part1_mpi.exr"), "murk:part"), "1/3");
+}
+
+static void error_on_one_rank_stops_the_job(void **state)
+{
+    (void)state;
+    char *log = NULL;
+    /* MPMD: rank 0 as usual, rank 1 with a grid limit its cloud exceeds */
+    const char *argv[] = {getenv("MURK_MPIRUN"), "--oversubscribe",
+                          "-n", "1", getenv("MURK_EXE"), "render", src_path(SCENE), "-o", tmp_path("err.exr"),
+                          "--set", RES, "--quiet", ":",
+                          "-n", "1", "-x", "MURK_MAX_GRID_VOXELS=8", getenv("MURK_EXE"), "render", src_path(SCENE),
+                          "-o", tmp_path("err.exr"), "--set", RES, "--quiet", NULL};
+    int rc = run_argv(&log, argv);
+    assert_int_not_equal(rc, 0);
+    assert_contains(log, "cornell_smoke.yaml:");
+    assert_contains(log, "beyond the limit of 8 (MURK_MAX_GRID_VOXELS)");
+    assert_contains(log, "the error of rank 1 of 2");
+    free(log);
+    struct stat st;
+    assert_int_not_equal(stat(tmp_path("err.exr"), &st), 0);
+    assert_int_not_equal(stat(tmp_path("err.png"), &st), 0);
+}
+
+int main(void)
+{
+    const char *mpirun = getenv("MURK_MPIRUN");
+    if (!mpirun || !*mpirun) {
+        printf("murk is built without MPI (or mpirun is missing): skipped\n");
+        return 77;
+    }
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1); /* CI and these machines run as root */
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(ranks_give_the_single_process_image),
+        cmocka_unit_test(resumed_by_other_ranks),
+        cmocka_unit_test(time_limit_passes_are_rank0s),
+        cmocka_unit_test(part_rendered_by_ranks),
+        cmocka_unit_test(error_on_one_rank_stops_the_job),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,430 @@
+/* test_sampler.c — the sampler of murk/math.h (issue 15): the padded Owen-scrambled Sobol points are
+ * stratified in every slot, differ per pixel and per seed, integrate a disk faster than independent
+ * numbers; the independent sampler is the PCG stream in call order; renders with sobol are bitwise
+ * identical for 1 and 2 threads, for --time passes and for a checkpoint resumed; render.sampler is
+ * read and checked like every scene key. And the solid-angle sampling of rectangular lights
+ * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
+#include "testutil.h"
+#include "host.h"
+#include "image.h"
+#include "scene.h"
+
+#include "murk/math.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The slots the integrators use (pathtracer.c: camera 0, hero 1, then 5 per scattering event) for the
+ * first 12 events, and more: every slot is made the same way. */
+enum { NSLOTS = 2 + 5 * 12 };
+
+static void point(uint32_t sampler, uint64_t seed, uint64_t pixel, uint32_t index, uint32_t slot, float u[2])
+{
+    murk_rng r;
+    murk_sampler_start(&r, sampler, seed, pixel, index);
+    murk_sample_seek(&r, slot);
+    murk_sample_2d(&r, u);
+}
+
+/* The first 2^k points of a slot: one in each elementary interval 2^-a x 2^-(k-a), a = 0..k. */
+static int stratified(uint64_t seed, uint64_t pixel, uint32_t slot, int k)
+{
+    uint32_t n = 1u << k;
+    unsigned char *seen = calloc(n, 1);
+    float(*u)[2] = malloc(n * sizeof *u);
+    assert_non_null(seen);
+    assert_non_null(u);
+    for (uint32_t i = 0; i < n; i++) {
+        point(MURK_SAMPLER_SOBOL, seed, pixel, i, slot, u[i]);
+        assert_true(u[i][0] >= 0.0f && u[i][0] < 1.0f && u[i][1] >= 0.0f && u[i][1] < 1.0f);
+    }
+    int ok = 1;
+    for (int a = 0; a <= k && ok; a++) {
+        memset(seen, 0, n);
+        for (uint32_t i = 0; i < n; i++) {
+            uint32_t cx = (uint32_t)(u[i][0] * (float)(1u << a)), cy = (uint32_t)(u[i][1] * (float)(1u << (k - a)));
+            uint32_t cell = (cx << (k - a)) | cy;
+            if (seen[cell]++) {
+                fprintf(stderr, "seed %llu pixel %llu slot %u: 2^%d points, two in a 2^-%d x 2^-%d cell\n",
+                        (unsigned long long)seed, (unsigned long long)pixel, slot, k, a, k - a);
+                ok = 0;
+                break;
+            }
+        }
+    }
+    free(seen);
+    free(u);
+    return ok;
+}
+
+static void test_stratified(void **state)
+{
+    (void)state;
+    static const uint64_t seeds[] = {0, 1, 12345};
+    static const uint64_t pixels[] = {0, 1, 777, 262143};
+    for (size_t s = 0; s < 3; s++)
+        for (size_t p = 0; p < 4; p++)
+            for (uint32_t slot = 0; slot < NSLOTS; slot++)
+                for (int k = 0; k <= 10; k += (k < 6 ? 1 : 4))
+                    assert_true(stratified(seeds[s], pixels[p], slot, k));
+    /* 1-D slots give the first coordinate of the 2-D point of the same slot */
+    for (uint32_t i = 0; i < 64; i++) {
+        murk_rng r;
+        float u[2];
+        point(MURK_SAMPLER_SOBOL, 3, 9, i, 7, u);
+        murk_sampler_start(&r, MURK_SAMPLER_SOBOL, 3, 9, i);
+        murk_sample_seek(&r, 7);
+        assert_true(murk_sample_1d(&r) == u[0]);
+    }
+}
+
+/* Correlation of u[c] between two streams over n samples, for slot `slot`. */
+static double correlation(uint64_t s1, uint64_t p1, uint32_t slot1, uint64_t s2, uint64_t p2, uint32_t slot2, int c,
+                          uint32_t n, uint32_t *same)
+{
+    double sa = 0, sb = 0, sab = 0, saa = 0, sbb = 0;
+    *same = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        float a[2], b[2];
+        point(MURK_SAMPLER_SOBOL, s1, p1, i, slot1, a);
+        point(MURK_SAMPLER_SOBOL, s2, p2, i, slot2, b);
+        *same += a[0] == b[0] && a[1] == b[1];
+        sa += a[c], sb += b[c], sab += (double)a[c] * b[c], saa += (double)a[c] * a[c], sbb += (double)b[c] * b[c];
+    }
+    double cov = sab / n - (sa / n) * (sb / n);
+    return cov / sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n)));
+}
+
+/* Neighbouring pixels, seeds and slots see different, uncorrelated sequences: |corr| within 4 standard
+ * errors (1 / sqrt(n) for independent uniforms) and no point shared. */
+static void test_decorrelated(void **state)
+{
+    (void)state;
+    const uint32_t n = 4096;
+    const double tol = 4.0 / sqrt((double)n);
+    struct { uint64_t s1, p1, s2, p2; uint32_t slot1, slot2; const char *what; } cases[] = {
+        {0, 100, 0, 101, 0, 0, "neighbouring pixels"}, {0, 100, 1, 100, 0, 0, "seeds 0 and 1"},
+        {5, 7, 5, 7 + 512, 4, 4, "pixels a row apart"}, {5, 7, 5, 7, 3, 4, "slots 3 and 4"},
+        {9, 0, 10, 1, 2, 2, "seed and pixel both + 1"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        for (int c = 0; c < 2; c++) {
+            uint32_t same;
+            double r = correlation(cases[i].s1, cases[i].p1, cases[i].slot1, cases[i].s2, cases[i].p2, cases[i].slot2, c,
+                                   n, &same);
+            printf("%-26s coordinate %d: correlation %+.4f (limit %.4f), %u shared points\n", cases[i].what, c, r, tol,
+                   same);
+            assert_true(fabs(r) < tol);
+            assert_int_equal(same, 0);
+        }
+}
+
+/* The independent sampler (and a stream murk_rng_seed made) is the PCG stream in call order. */
+static void test_independent_is_pcg(void **state)
+{
+    (void)state;
+    for (uint32_t i = 0; i < 16; i++) {
+        murk_rng a, b, c;
+        murk_sampler_start(&a, MURK_SAMPLER_INDEPENDENT, 4, 5, i);
+        murk_rng_seed(&b, 4, 5, i);
+        murk_rng_seed(&c, 4, 5, i);
+        float u[2];
+        murk_sample_seek(&a, 9);
+        murk_sample_2d(&a, u);
+        assert_true(u[0] == murk_rng_float(&b) && u[1] == murk_rng_float(&b));
+        assert_true(murk_sample_1d(&a) == murk_rng_float(&b));
+        murk_rng_seed(&b, 4, 5, i);
+        murk_sample_2d(&c, u); /* an rng murk_rng_seed made draws independently too */
+        assert_true(u[0] == murk_rng_float(&b) && u[1] == murk_rng_float(&b));
+        assert_true(murk_sample_1d(&c) == murk_rng_float(&b));
+    }
+}
+
+/* Root-mean-square error of the disk-area estimate with 2^k points over `reps` pixels (replicates),
+ * k = 0..kmax, and the standard error of each log2 RMSE (from the spread of the squared errors). */
+static void disk_rmse(uint32_t sampler, int kmax, int reps, double *log2_rmse, double *se)
+{
+    const double r2 = 0.4 * 0.4, truth = M_PI * r2;
+    uint32_t n = 1u << kmax;
+    double *m = calloc((size_t)kmax + 1, sizeof *m), *m2 = calloc((size_t)kmax + 1, sizeof *m2);
+    assert_non_null(m);
+    assert_non_null(m2);
+    for (int rep = 0; rep < reps; rep++) {
+        double hits = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            float u[2];
+            point(sampler, 2026, (uint64_t)rep, i, 3, u);
+            double dx = u[0] - 0.5, dy = u[1] - 0.5;
+            hits += dx * dx + dy * dy < r2;
+            if (((i + 1) & i) == 0) { /* i + 1 is a power of two */
+                int k = 0;
+                while ((1u << k) < i + 1)
+                    k++;
+                double e = hits / (double)(i + 1) - truth;
+                m[k] += e * e, m2[k] += e * e * e * e;
+            }
+        }
+    }
+    for (int k = 0; k <= kmax; k++) {
+        double mse = m[k] / reps, var = m2[k] / reps - mse * mse;
+        log2_rmse[k] = 0.5 * log2(mse);
+        se[k] = 0.5 * sqrt(var / reps) / mse / log(2.0);
+    }
+    free(m);
+    free(m2);
+}
+
+/* Least-squares slope of y over k = k0..k1 and its standard error from the per-point errors. */
+static double slope(const double *y, const double *se, int k0, int k1, double *slope_se)
+{
+    double kbar = 0, ybar = 0, sxx = 0, sxy = 0, var = 0;
+    int n = k1 - k0 + 1;
+    for (int k = k0; k <= k1; k++)
+        kbar += k, ybar += y[k];
+    kbar /= n, ybar /= n;
+    for (int k = k0; k <= k1; k++)
+        sxx += (k - kbar) * (k - kbar), sxy += (k - kbar) * (y[k] - ybar);
+    for (int k = k0; k <= k1; k++)
+        var += (k - kbar) * (k - kbar) * se[k] * se[k];
+    *slope_se = sqrt(var) / sxx;
+    return sxy / sxx;
+}
+
+/* The disk's area (a discontinuous integrand): independent numbers converge as N^-1/2, scrambled Sobol
+ * as N^-3/4 (variance N^-3/2, Owen 1997). The fitted slope must lie 4 standard errors below -1/2, and
+ * at N = 1024 the RMSE must be below independent's by more than 4 standard errors. */
+static void test_disk_convergence(void **state)
+{
+    (void)state;
+    enum { KMAX = 10, REPS = 1024 };
+    double ys[KMAX + 1], ses[KMAX + 1], yi[KMAX + 1], sei[KMAX + 1], ss, si;
+    disk_rmse(MURK_SAMPLER_SOBOL, KMAX, REPS, ys, ses);
+    disk_rmse(MURK_SAMPLER_INDEPENDENT, KMAX, REPS, yi, sei);
+    double bs = slope(ys, ses, 4, KMAX, &ss), bi = slope(yi, sei, 4, KMAX, &si);
+    printf("disk area RMSE slope over N = 16..1024: sobol %.3f +- %.3f, independent %.3f +- %.3f\n", bs, ss, bi, si);
+    printf("RMSE at N = 1024: sobol %.3g, independent %.3g (ratio %.1f)\n", exp2(ys[KMAX]), exp2(yi[KMAX]),
+           exp2(yi[KMAX] - ys[KMAX]));
+    assert_true(fabs(bi + 0.5) < 4.0 * si);  /* the harness sees Monte Carlo's rate */
+    assert_true(bs + 4.0 * ss < -0.5);        /* measurably faster than it */
+    assert_true(ys[KMAX] + 4.0 * hypot(ses[KMAX], sei[KMAX]) < yi[KMAX]);
+}
+
+/* ---- renders ------------------------------------------------------------------------------- */
+
+static void render_ok(const char *out, const char *const *extra)
+{
+    const char *args[32] = {"render", src_path("scenes/cornell_smoke.yaml"), "-o", out, "--quiet",
+                            "--set", "render.resolution=[40,32]", "--set", "render.sampler=sobol"};
+    size_t n = 9;
+    for (size_t i = 0; extra && extra[i]; i++)
+        args[n++] = extra[i];
+    args[n] = NULL;
+    char *log = NULL;
+    int rc = run_murk_argv(&log, args);
+    if (rc != 0)
+        fprintf(stderr, "murk render failed (%d):\n%s\n", rc, log);
+    assert_int_equal(rc, 0);
+    free(log);
+}
+
+static int same_image(const char *a, const char *b)
+{
+    murk_image A = {0}, B = {0};
+    char err[512];
+    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err))
+        fail_msg("%s", err);
+    int same = A.w == B.w && A.h == B.h && memcmp(A.rgb, B.rgb, 3 * sizeof(float) * (size_t)A.w * (size_t)A.h) == 0;
+    murk_image_free(&A);
+    murk_image_free(&B);
+    return same;
+}
+
+static const char *out_path(const char *name)
+{
+    static char buf[4][512];
+    static int k;
+    k = (k + 1) % 4;
+    snprintf(buf[k], sizeof buf[k], "%s/%s", tmp_dir(), name);
+    return buf[k];
+}
+
+/* cornell_smoke (surfaces, a cloud, NEE through it) with sobol: 1 and 2 threads, one pass and --time's
+ * passes, a checkpoint at 3 spp resumed to 8: every pixel bitwise the same. And independent differs. */
+static void test_render_bitwise(void **state)
+{
+    (void)state;
+    const char *ref = out_path("one.exr");
+    const char *one[] = {"--threads", "1", "--spp", "8", NULL};
+    render_ok(ref, one);
+    const char *two[] = {"--threads", "2", "--spp", "8", NULL};
+    render_ok(out_path("two.exr"), two);
+    assert_true(same_image(ref, out_path("two.exr")));
+    const char *timed[] = {"--threads", "2", "--spp", "8", "--time", "600", NULL}; /* passes of 1, then more */
+    render_ok(out_path("timed.exr"), timed);
+    assert_true(same_image(ref, out_path("timed.exr")));
+    const char *ck = out_path("ck");
+    const char *part[] = {"--threads", "2", "--spp", "3", "--checkpoint", ck, "--every", "0", NULL};
+    render_ok(out_path("part.exr"), part);
+    const char *rest[] = {"--threads", "2", "--spp", "8", "--resume", ck, NULL};
+    render_ok(out_path("resumed.exr"), rest);
+    assert_true(same_image(ref, out_path("resumed.exr")));
+    const char *indep[] = {"--threads", "2", "--spp", "8", "--set", "render.sampler=independent", NULL};
+    render_ok(out_path("indep.exr"), indep);
+    assert_false(same_image(ref, out_path("indep.exr")));
+}
+
+static void test_scene_key(void **state)
+{
+    (void)state;
+    const char *scene = write_tmp("bad_sampler.yaml", "murk: 1\n"
+                                                      "render: { resolution: [8, 8], sampler: halton }\n"
+                                                      "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 30 }\n");
+    char *log = NULL;
+    int rc = run_murk(&log, "render", scene, "-o", out_path("bad.exr"), "--quiet", (char *)NULL);
+    assert_int_equal(rc, 1);
+    assert_contains(log, "bad_sampler.yaml:2:");
+    assert_contains(log, "render.sampler must be one of sobol|independent, got 'halton'");
+    free(log);
+    rc = run_murk(&log, "render", scene, "-o", out_path("bad.exr"), "--quiet", "--set", "render.sampler=[1]", (char *)NULL);
+    assert_int_equal(rc, 1);
+    assert_contains(log, "render.sampler");
+    free(log);
+}
+
+
+/* ---- light sampling ------------------------------------------------------------------------ */
+
+/* MURK_LIGHT_SOLID_ANGLE on a tilted rectangular light seen from a far, a near, a side and two grazing
+ * points:
+ * 200k samples binned 16 x 16 over the rectangle's (a, b) coordinates against the expected counts
+ * N * integral over the bin of pdf(w) dw = N * sum pdf cos_l / d^2 dA (32 x 32 midpoints per bin);
+ * p >= 1e-4, the expected counts sum to N (the pdf integrates to 1) and every sample's pdf equals
+ * light_pdf_with() at its point. */
+static void test_rect_light_chi2(void **state)
+{
+    (void)state;
+    const char *text = "murk: 1\n"
+                       "render: { resolution: [8, 8] }\n"
+                       "camera: { from: [0, 1, 4], at: [0, 1, 0], up: [0, 1, 0], fov: 30 }\n"
+                       "materials: { m: { type: diffuse, albedo: 0.5 } }\n"
+                       "shapes:\n"
+                       "  - { type: quad, center: [0.3, 2, -0.2], u: [0.4, 0.1, 0], v: [0, 0, 0.3], material: m, emission: [4, 3, 2] }\n";
+    char err[512];
+    murk_scene *s = murk_scene_load(write_tmp("rect.yaml", text), NULL, 0, err, sizeof err);
+    if (!s)
+        fail_msg("%s", err);
+    const murk_host *h = murk_host_table();
+    assert_true(MURK_HAS(h->size, murk_host, light_pdf_with));
+    const murk_vec3 c = murk_v3(0.3f, 2.0f, -0.2f), u = murk_v3(0.4f, 0.1f, 0.0f), v = murk_v3(0.0f, 0.0f, 0.3f);
+    const murk_vec3 p0 = murk_sub(murk_sub(c, u), v), ex = murk_mul(u, 2.0f), ey = murk_mul(v, 2.0f);
+    const murk_vec3 n = murk_normalize(murk_cross(ex, ey));
+    const double area = murk_length(murk_cross(ex, ey));
+    /* offsets from the centre along (u, v, n): far below, near, to the side, and two grazing ones */
+    static const float pts[][3] = {{-0.3f, 0.2f, 1.5f}, {0.1f, 0.1f, 0.15f}, {1.0f, 0.5f, 0.3f},
+                                   {1.2f, 0.0f, 0.01f}, {0.1f, 0.8f, 0.02f}};
+    enum { NB = 16, SUB = 32, N = 200000 };
+    for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
+        murk_vec3 p = murk_add(c, murk_add(murk_add(murk_mul(murk_normalize(u), pts[k][0]), murk_mul(murk_normalize(v), pts[k][1])),
+                                           murk_mul(n, pts[k][2])));
+        assert_true(murk_dot(murk_sub(p, p0), n) > 0.0f); /* on the emitting side */
+        static double obs[NB * NB], expct[NB * NB];
+        memset(obs, 0, sizeof obs);
+        memset(expct, 0, sizeof expct);
+        murk_rng rng;
+        murk_rng_seed(&rng, 15, k, 0);
+        long bad_pdf = 0;
+        for (long i = 0; i < N; i++) {
+            float uu[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};
+            murk_light_sample ls;
+            assert_true(h->sample_light_with(s, p, uu, MURK_LIGHT_SOLID_ANGLE, &ls));
+            murk_vec3 q = murk_madd(p, ls.wi, ls.dist), d = murk_sub(q, p0);
+            double a = murk_dot(d, ex) / murk_dot(ex, ex), b = murk_dot(d, ey) / murk_dot(ey, ey);
+            assert_true(a > -1e-4 && a < 1.0 + 1e-4 && b > -1e-4 && b < 1.0 + 1e-4);
+            int ia = (int)(a * NB), ib = (int)(b * NB);
+            ia = ia < 0 ? 0 : (ia >= NB ? NB - 1 : ia);
+            ib = ib < 0 ? 0 : (ib >= NB ? NB - 1 : ib);
+            obs[ia * NB + ib] += 1.0;
+            murk_hit hit = {0};
+            hit.p = q;
+            hit.light = 0;
+            float pdf = h->light_pdf_with(s, p, &hit, MURK_LIGHT_SOLID_ANGLE);
+            bad_pdf += fabsf(pdf - ls.pdf) > 1e-4f * ls.pdf;
+        }
+        double total = 0.0;
+        for (int ia = 0; ia < NB * SUB; ia++)
+            for (int ib = 0; ib < NB * SUB; ib++) {
+                double a = (ia + 0.5) / (NB * SUB), b = (ib + 0.5) / (NB * SUB);
+                murk_vec3 q = murk_add(p0, murk_add(murk_mul(ex, (float)a), murk_mul(ey, (float)b)));
+                murk_vec3 d = murk_sub(q, p);
+                double d2 = murk_dot(d, d), cosl = -murk_dot(n, d) / sqrt(d2);
+                murk_hit hit = {0};
+                hit.p = q;
+                hit.light = 1;
+                double dA = area / ((double)NB * SUB * NB * SUB);
+                double e = h->light_pdf_with(s, p, &hit, MURK_LIGHT_SOLID_ANGLE) * cosl / d2 * dA;
+                expct[(ia / SUB) * NB + ib / SUB] += N * e;
+                total += e;
+            }
+        int dof;
+        double pv = chi2_test(obs, expct, NB * NB, 5.0, &dof);
+        printf("rectangle light from (%.2f, %.2f, %.2f): chi2 p = %.4f (%d dof), integral of pdf %.5f, "
+               "%ld pdf mismatches\n", p.x, p.y, p.z, pv, dof, total, bad_pdf);
+        assert_true(pv >= 1e-4);
+        assert_true(fabs(total - 1.0) < 2e-3);
+        assert_int_equal(bad_pdf, 0);
+    }
+    murk_scene_free(s);
+}
+
+/* ---- the expected image ------------------------------------------------------------------------ */
+
+/* The sobol sampler with solid-angle light sampling against murk before both (independent, area):
+ * two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree, |z| <= 4.5
+ * per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
+static void test_same_image(void **state)
+{
+    (void)state;
+    static const char *const medium[] = {"--set", "media.smoke.density={constant: 1}", "--set",
+                                         "media.smoke.sigma_a=[0.05, 0.1, 0.3]", "--set",
+                                         "media.smoke.sigma_s=[1.2, 0.8, 0.4]", NULL};
+    struct { const char *label, *scene, *spp; const char *const *extra; } cases[] = {
+        {"cornell", "scenes/cornell.yaml", "256", NULL},
+        {"cornell_smoke", "scenes/cornell_smoke.yaml", "64", NULL},
+        {"constant chromatic medium", "scenes/cornell_smoke.yaml", "64", medium},
+    };
+    int nfail = 0;
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        const char *a_args[24] = {"--set", "render.resolution=[32,32]", "--spp", cases[i].spp}, *b_args[24];
+        size_t n = 4;
+        for (size_t k = 0; cases[i].extra && cases[i].extra[k]; k++)
+            a_args[n++] = cases[i].extra[k];
+        memcpy(b_args, a_args, sizeof a_args);
+        b_args[n] = "--set", b_args[n + 1] = "render.sampler=independent";
+        b_args[n + 2] = "--set", b_args[n + 3] = "integrator.light_sampling=area", b_args[n + 4] = NULL;
+        a_args[n] = "--set", a_args[n + 1] = "integrator.light_sampling=solid_angle", a_args[n + 2] = NULL;
+        img_stack a, b;
+        img_stack_render(&a, src_path(cases[i].scene), "new.exr", 6, 10, a_args);
+        img_stack_render(&b, src_path(cases[i].scene), "old.exr", 6, 1000, b_args);
+        nfail += !img_stack_agree(cases[i].label, &a, &b, 4, 4.5);
+        img_stack_free(&a);
+        img_stack_free(&b);
+    }
+    assert_int_equal(nfail, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_stratified),
+        cmocka_unit_test(test_decorrelated),
+        cmocka_unit_test(test_independent_is_pcg),
+        cmocka_unit_test(test_disk_convergence),
+        cmocka_unit_test(test_rect_light_chi2),
+        cmocka_unit_test(test_scene_key),
+        cmocka_unit_test(test_render_bitwise),
+        cmocka_unit_test(test_same_image),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
