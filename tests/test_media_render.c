@@ -453,7 +453,7 @@ static void test_stability(void **state)
         char label[96];
         snprintf(label, sizeof label, "%s majorant x0.5", TRACKERS[t]);
         stable(label, tk, "density: " CLOUD ", sigma_a: [0.2, 0.5, 1], sigma_s: [2, 3, 4], majorant_factor: 0.5",
-               SPHERE, "exceeds");
+               SPHERE, "below the density"); /* repaired before rendering (docs/stability.md), and said */
         snprintf(label, sizeof label, "%s chromaticity 1000:1", TRACKERS[t]);
         stable(label, tk, "density: " CLOUD ", sigma_a: 0, sigma_s: [0.001, 1, 1], scale: 4", SPHERE,
                "strongly chromatic");
@@ -467,11 +467,11 @@ static void test_stability(void **state)
         stable(label, tk, "density: " CLOUD ", sigma_a: 0, sigma_s: [4, 5, 6], scale: 3", SPHERE, NULL);
     }
     stable("decomposition control 2", "type: decomposition, control: 2",
-           "density: " CLOUD ", sigma_a: 0.2, sigma_s: [2, 3, 4]", SPHERE, "exceeds");
+           "density: " CLOUD ", sigma_a: 0.2, sigma_s: [2, 3, 4]", SPHERE, "exceed");
     stable("decomposition control 2, constant", "type: decomposition, control: 2",
-           "density: { constant: 1 }, sigma_a: 0.2, sigma_s: [2, 3, 4]", SPHERE, "exceeds");
+           "density: { constant: 1 }, sigma_a: 0.2, sigma_s: [2, 3, 4]", SPHERE, "exceed");
     stable("decomposition control 2, majorant x0.5", "type: decomposition, control: 2",
-           "density: " CLOUD ", sigma_a: 0.2, sigma_s: [0.001, 3, 4], majorant_factor: 0.5", SPHERE, "exceeds");
+           "density: " CLOUD ", sigma_a: 0.2, sigma_s: [0.001, 3, 4], majorant_factor: 0.5", SPHERE, "exceed");
     printf("stability: %.1f s\n", now() - t0);
     assert_int_equal(nfail, 0);
 }

@@ -6,7 +6,8 @@ constant background — is swept one parameter at a time around a base case, and
 with every tracker (and, for the shadow rays, every unbiased transmittance estimator under delta).
 Per point and method: non-finite samples, the largest sample over its pixel's reference mean, the
 firefly rate (share of samples above 100x their pixel's reference mean), the relative variance of the pixel means (from the
-samples themselves), time, efficiency = 1 / (relative variance x time) relative to delta's, and a bias
+samples themselves), time, density lookups (murk's cost counters), efficiency = 1 / (relative variance x
+time) and 1 / (relative variance x lookups), each relative to delta's, and a bias
 z-score of the image mean per channel against a reference: the closed form where one exists (the
 absorbing homogeneous box seen from outside: E[pixel] = background x exp(-sigma_t x chord), integrated
 over each pixel's footprint), else spectral_mis with a bounding majorant and control (majorant_factor
@@ -120,10 +121,12 @@ def render(path, out, res, spp):
         sys.exit("murk render %s failed:\n%s%s" % (path, r.stdout, r.stderr))
     m = re.search(r"(\d+) spp, ([0-9.]+) s", r.stdout + r.stderr)
     secs = float(m.group(2)) if m else float("nan")
+    m = re.search(r"medium 'm': (\d+) lookups", r.stdout + r.stderr)  # murk's cost counters
+    lookups = int(m.group(1)) if m else -1
     x = np.fromfile(dump, dtype=np.float32).reshape(res * res, spp, 3)
     os.remove(dump)
     warn = sorted(set(l for l in (r.stdout + r.stderr).splitlines() if "warning" in l))
-    return secs, x, warn
+    return secs, lookups, x, warn
 
 
 def camera_dirs(p, res, sub):
@@ -247,7 +250,7 @@ def run(a):
                     path = os.path.join(out, tag + "_ref.yaml")
                     with open(path, "w") as f:
                         f.write(scene_yaml(rp, medium, "spectral_mis", None, res, ref_spp, 777))
-                    _, x, _ = render(path, os.path.join(out, tag + "_ref"), res, ref_spp)
+                    _, _, x, _ = render(path, os.path.join(out, tag + "_ref"), res, ref_spp)
                     rs = stats(x)
                     ref, ref_var, ref_kind = rs["mean"], rs["var_mean"], "spectral_mis %d spp" % ref_spp
                 for tracker, est in methods:
@@ -255,13 +258,15 @@ def run(a):
                     path = os.path.join(out, "%s_%s.yaml" % (tag, name))
                     with open(path, "w") as f:
                         f.write(scene_yaml(p, medium, tracker, est, res, spp, 1))
-                    secs, x, warn = render(path, os.path.join(out, "%s_%s" % (tag, name)), res, spp)
+                    secs, lookups, x, warn = render(path, os.path.join(out, "%s_%s" % (tag, name)), res, spp)
                     s = stats(x, ref)
                     zi, zb = zscore(s, ref, ref_var, mask)
                     rv = relvar(s)
                     row = dict(sweep=sweep, medium=medium, value=v, method=name, nonfinite=s["nonfinite"],
                                maxratio=s["maxratio"], firefly=s["fire"], relvar=rv, seconds=secs,
-                               eff=1.0 / (rv * secs) if rv > 0 and secs > 0 else float("inf"), z=zi, zblock=zb,
+                               eff=1.0 / (rv * secs) if rv > 0 and secs > 0 else float("inf"), lookups=lookups,
+                               eff_lookups=1.0 / (rv * lookups) if rv > 0 and lookups > 0 else float("nan"),
+                               z=zi, zblock=zb,
                                ref=ref_kind, warnings=warn)
                     rows.append(row)
                     print("%-26s %-12s %-7s %-30s nonfinite %d  max/mean %9.3g  fireflies %.2e  relvar %.3e  "
@@ -271,6 +276,8 @@ def run(a):
         base = [q for q in rows if q["sweep"] == r["sweep"] and q["medium"] == r["medium"] and
                 q["value"] == r["value"] and q["method"] == "delta"]
         r["eff_rel"] = r["eff"] / base[0]["eff"] if base and base[0]["eff"] > 0 else float("nan")
+        bl = base[0]["eff_lookups"] if base else float("nan")
+        r["eff_lookups_rel"] = r["eff_lookups"] / bl if bl > 0 and r["eff_lookups"] > 0 else float("nan")
     meta = dict(res=res, spp=spp, ref_spp=ref_spp, quick=a.quick, minutes=(time.time() - t_start) / 60.0,
                 violations=[] if a.quick else violations(out))
     meta["minutes_all"] = (time.time() - t_start) / 60.0
