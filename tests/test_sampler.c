@@ -296,7 +296,8 @@ static void test_scene_key(void **state)
 
 /* ---- light sampling ------------------------------------------------------------------------ */
 
-/* MURK_LIGHT_SOLID_ANGLE on a tilted rectangular light seen from a far, a near and a grazing point:
+/* MURK_LIGHT_SOLID_ANGLE on a tilted rectangular light seen from a far, a near, a side and two grazing
+ * points:
  * 200k samples binned 16 x 16 over the rectangle's (a, b) coordinates against the expected counts
  * N * integral over the bin of pdf(w) dw = N * sum pdf cos_l / d^2 dA (32 x 32 midpoints per bin);
  * p >= 1e-4, the expected counts sum to N (the pdf integrates to 1) and every sample's pdf equals
@@ -320,10 +321,13 @@ static void test_rect_light_chi2(void **state)
     const murk_vec3 p0 = murk_sub(murk_sub(c, u), v), ex = murk_mul(u, 2.0f), ey = murk_mul(v, 2.0f);
     const murk_vec3 n = murk_normalize(murk_cross(ex, ey));
     const double area = murk_length(murk_cross(ex, ey));
-    static const float pts[][3] = {{0.0f, 0.5f, 0.0f}, {0.35f, 1.85f, -0.1f}, {1.2f, 1.95f, 0.3f}};
+    /* offsets from the centre along (u, v, n): far below, near, to the side, and two grazing ones */
+    static const float pts[][3] = {{-0.3f, 0.2f, 1.5f}, {0.1f, 0.1f, 0.15f}, {1.0f, 0.5f, 0.3f},
+                                   {1.2f, 0.0f, 0.01f}, {0.1f, 0.8f, 0.02f}};
     enum { NB = 16, SUB = 32, N = 200000 };
     for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
-        murk_vec3 p = murk_v3(pts[k][0], pts[k][1], pts[k][2]);
+        murk_vec3 p = murk_add(c, murk_add(murk_add(murk_mul(murk_normalize(u), pts[k][0]), murk_mul(murk_normalize(v), pts[k][1])),
+                                           murk_mul(n, pts[k][2])));
         assert_true(murk_dot(murk_sub(p, p0), n) > 0.0f); /* on the emitting side */
         static double obs[NB * NB], expct[NB * NB];
         memset(obs, 0, sizeof obs);
@@ -376,7 +380,7 @@ static void test_rect_light_chi2(void **state)
 
 /* ---- the expected image ------------------------------------------------------------------------ */
 
-/* The new defaults (sobol, solid-angle light sampling) against murk before them (independent, area):
+/* The sobol sampler with solid-angle light sampling against murk before both (independent, area):
  * two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree, |z| <= 4.5
  * per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
 static void test_same_image(void **state)
@@ -399,7 +403,7 @@ static void test_same_image(void **state)
         memcpy(b_args, a_args, sizeof a_args);
         b_args[n] = "--set", b_args[n + 1] = "render.sampler=independent";
         b_args[n + 2] = "--set", b_args[n + 3] = "integrator.light_sampling=area", b_args[n + 4] = NULL;
-        a_args[n] = NULL;
+        a_args[n] = "--set", a_args[n + 1] = "integrator.light_sampling=solid_angle", a_args[n + 2] = NULL;
         img_stack a, b;
         img_stack_render(&a, src_path(cases[i].scene), "new.exr", 6, 10, a_args);
         img_stack_render(&b, src_path(cases[i].scene), "old.exr", 6, 1000, b_args);

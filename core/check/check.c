@@ -146,6 +146,7 @@ static void check_chi2(ck *c, const mat_ref *r, murk_vec3 wo, const char *label)
         float u[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};
         murk_bsdf_sample s;
         memset(&s, 0, sizeof s);
+        s.eta = 1.0f; /* as the integrators set it */
         if (!m->vt->sample(m->self, &r->hit, wo, u, &s) || s.delta) {
             obs[nb] += 1.0; /* no sample, or a delta lobe (which pdf() does not describe) */
             continue;
@@ -187,7 +188,9 @@ static void check_chi2(ck *c, const mat_ref *r, murk_vec3 wo, const char *label)
     free(expd);
 }
 
-static void check_albedo(ck *c, const mat_ref *r, murk_vec3 wo, const char *label)
+/* eta_ch (NULL: reflection only): each channel's relative index (inside / outside), for the energy of
+ * transmitted samples; inside: wo is inside. */
+static void check_albedo(ck *c, const mat_ref *r, murk_vec3 wo, const double *eta_ch, int inside, const char *label)
 {
     long n = c->quick ? 50000 : 200000;
     murk_rng rng;
@@ -197,10 +200,18 @@ static void check_albedo(ck *c, const mat_ref *r, murk_vec3 wo, const char *labe
         float u[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};
         murk_bsdf_sample s;
         memset(&s, 0, sizeof s);
+        s.eta = 1.0f;
         if (!r->m->vt->sample(r->m->self, &r->hit, wo, u, &s) || !(s.pdf > 0.0f))
             continue;
         for (int ch = 0; ch < 3; ch++) {
-            double w = (double)s.f.c[ch] * fabs((double)s.wi.z) / (double)s.pdf;
+            /* energy, not radiance: transmitted radiance is (eta_wo / eta_wi)^2 times the energy (each
+             * channel's own index: with dispersion s->eta is only the sampled channel's) */
+            double e2 = 1.0;
+            if (s.wi.z < 0.0f) {
+                double e = eta_ch && eta_ch[ch] > 0.0 ? (inside ? 1.0 / eta_ch[ch] : eta_ch[ch]) : s.eta;
+                e2 = e * e;
+            }
+            double w = (double)s.f.c[ch] * fabs((double)s.wi.z) / (double)s.pdf * e2;
             s1[ch] += w;
             s2[ch] += w * w;
         }
@@ -213,7 +224,7 @@ static void check_albedo(ck *c, const mat_ref *r, murk_vec3 wo, const char *labe
         if (!(mean[ch] <= 1.0 + 4.0 * se[ch] + 1e-4))
             ok = 0;
     }
-    report(c, ok, "furnace     %-28s albedo %.4f+-%.4f %.4f+-%.4f %.4f+-%.4f (<= 1)", label, mean[0], se[0], mean[1],
+    report(c, ok, "furnace     %-28s energy albedo %.4f+-%.4f %.4f+-%.4f %.4f+-%.4f (<= 1)", label, mean[0], se[0], mean[1],
            se[1], mean[2], se[2]);
 }
 
@@ -243,6 +254,157 @@ static void check_reciprocity(ck *c, const mat_ref *r, const char *label)
         }
     }
     report(c, bad == 0, "reciprocity %-28s f(wo,wi) = f(wi,wo) on 4096 pairs: max rel diff %.2e", label, worst);
+}
+
+/* Transmitting materials: the relative indices sample() reports (s->eta = eta_wi / eta_wo on transmitted
+ * samples, murk/material.h), from 20000 samples at wo = 45 degrees on each side. Returns the number of
+ * distinct indices seen from outside (into eta[], at most 3: one per channel), 0 if the material does
+ * not transmit. Reports one line: every index seen from inside must be the inverse of one seen outside. */
+#define CK_MAX_ETA 3
+static int learn_eta(ck *c, const mat_ref *out, const mat_ref *in, const char *label, double eta[CK_MAX_ETA])
+{
+    double seen[2][8];
+    int n[2] = {0, 0}, over = 0;
+    long ntrans = 0;
+    for (int side = 0; side < 2; side++) {
+        const mat_ref *r = side ? in : out;
+        murk_rng rng;
+        murk_rng_seed(&rng, c->seed, 0x657461657461ull, 5u + (uint64_t)side);
+        murk_vec3 wo = dir_of(CK_PI / 4.0, 0.3);
+        for (int k = 0; k < 20000; k++) {
+            float u[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};
+            murk_bsdf_sample s;
+            memset(&s, 0, sizeof s);
+            s.eta = 1.0f;
+            if (!r->m->vt->sample(r->m->self, &r->hit, wo, u, &s) || !(s.wi.z < 0.0f))
+                continue;
+            ntrans++;
+            int i = 0;
+            while (i < n[side] && !(fabs(seen[side][i] - s.eta) <= 1e-5 * seen[side][i]))
+                i++;
+            if (i == n[side]) {
+                if (n[side] < 8)
+                    seen[side][n[side]++] = s.eta;
+                else
+                    over = 1;
+            }
+        }
+    }
+    if (!ntrans)
+        return 0;
+    int ok = !over && n[0] <= CK_MAX_ETA && n[1] <= CK_MAX_ETA;
+    char line[256] = "";
+    size_t k = 0;
+    for (int side = 0; side < 2; side++) {
+        k += (size_t)snprintf(line + k, sizeof line - k, "%s", side ? "; inside" : " outside");
+        for (int i = 0; i < n[side] && k < sizeof line; i++) {
+            k += (size_t)snprintf(line + k, sizeof line - k, " %.5g", seen[side][i]);
+            if (side) { /* the inverse of one seen from outside */
+                int match = 0;
+                for (int j = 0; j < n[0]; j++)
+                    match |= fabs(seen[1][i] * seen[0][j] - 1.0) <= 1e-4;
+                ok &= match;
+            }
+        }
+    }
+    for (int i = 0; i < CK_MAX_ETA; i++)
+        eta[i] = i < n[0] ? seen[0][i] : 0.0;
+    report(c, ok, "eta         %-28s s->eta of transmitted samples:%s (inside: inverses of outside)", label, line);
+    return n[0] > 0 ? n[0] : 1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The reciprocity that holds across a refracting surface (murk/material.h): for a outside and b inside,
+ * eval(a, b) / eta_a^2 = eval(b, a) / eta_b^2, each seen from its own side (the frame flipped to wo's
+ * side: both mirrored in z, the hit saying inside). Per channel, the ratio eval(b, a) / eval(a, b) must
+ * be one constant over all pairs (its median is taken), and that constant the square of an index sample()
+ * reports (eta[]); with dispersion each channel has its own. Also plain reciprocity among directions
+ * inside. */
+static void check_reciprocity_tr(ck *c, const mat_ref *out, const mat_ref *in, const double eta[CK_MAX_ETA], const char *label,
+                                 double eta_ch[3])
+{
+    enum { NP = 4096 };
+    murk_vec3 *pa = malloc(NP * sizeof *pa), *pb = malloc(NP * sizeof *pb);
+    double *q = malloc(NP * sizeof *q);
+    if (!pa || !pb || !q) {
+        free(pa), free(pb), free(q);
+        report(c, 0, "reciprocity %-28s out of memory", label);
+        return;
+    }
+    murk_rng rng;
+    murk_rng_seed(&rng, c->seed, 0x7472616e736d6974ull, 6);
+    double worst_in = 0.0;
+    long bad_in = 0;
+    for (int k = 0; k < NP; k++) {
+        pa[k] = dir_of(acos(0.02 + 0.98 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        pb[k] = dir_of(acos(0.02 + 0.98 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        murk_rgb g = in->m->vt->eval(in->m->self, &in->hit, pa[k], pb[k]), h = in->m->vt->eval(in->m->self, &in->hit, pb[k], pa[k]);
+        for (int ch = 0; ch < 3; ch++) {
+            double m = fmax(fabs(g.c[ch]), fabs(h.c[ch])), d = m > 0.0 ? fabs(g.c[ch] - h.c[ch]) / m : 0.0;
+            if (!isfinite(g.c[ch]) || !isfinite(h.c[ch]))
+                d = INFINITY;
+            worst_in = fmax(worst_in, d);
+            bad_in += d > 1e-3;
+        }
+    }
+    int ok = 1;
+    double worst = 0.0;
+    char line[256] = "";
+    size_t len = 0;
+    for (int ch = 0; ch < 3; ch++) {
+        int nq = 0;
+        eta_ch[ch] = 0.0;
+        for (int pass = 0; pass < 2; pass++) {
+            double e2 = 0.0;
+            if (pass) { /* the constant: the median ratio */
+                if (!nq)
+                    break;
+                qsort(q, (size_t)nq, sizeof *q, cmp_double);
+                e2 = q[nq / 2];
+                int match = 0;
+                for (int i = 0; i < CK_MAX_ETA; i++)
+                    match |= eta[i] > 0.0 && fabs(e2 / (eta[i] * eta[i]) - 1.0) <= 1e-3;
+                ok &= match;
+                eta_ch[ch] = match ? sqrt(e2) : 0.0; /* the channel's index, for the energy check */
+                len += (size_t)snprintf(line + len, sizeof line - len, " %.5g", sqrt(e2));
+            }
+            for (int k = 0; k < NP; k++) {
+                murk_vec3 a = pa[k], b = pb[k], bb = murk_v3(b.x, b.y, -b.z), am = murk_v3(a.x, a.y, -a.z);
+                double x = out->m->vt->eval(out->m->self, &out->hit, a, bb).c[ch];
+                double y = in->m->vt->eval(in->m->self, &in->hit, b, am).c[ch];
+                if (!isfinite(x) || !isfinite(y)) {
+                    ok = 0;
+                    worst = INFINITY;
+                    continue;
+                }
+                if (!pass) {
+                    if (x > 0.0 && y > 0.0)
+                        q[nq++] = y / x;
+                    else if (x != 0.0 || y != 0.0) { /* one way only */
+                        ok = 0;
+                        worst = INFINITY;
+                    }
+                    continue;
+                }
+                double m = fmax(fabs(x), fabs(y / e2)), d = m > 0.0 ? fabs(x - y / e2) / m : 0.0;
+                worst = fmax(worst, d);
+                ok &= d <= 1e-3;
+            }
+        }
+        if (!nq)
+            len += (size_t)snprintf(line + len, sizeof line - len, " -");
+    }
+    report(c, ok, "reciprocity %-28s transmission f(a,b)/eta_a^2 = f(b,a)/eta_b^2 on 4096 pairs: max rel diff %.2e, eta per channel%s",
+           label, worst, line);
+    report(c, bad_in == 0, "reciprocity %-28s inside f(wo,wi) = f(wi,wo) on 4096 pairs: max rel diff %.2e", label, worst_in);
+    free(pa);
+    free(pb);
+    free(q);
 }
 
 /* Parameter sets: "" (defaults) and two with every numeric parameter moved inside its range. */
@@ -290,7 +452,7 @@ static void check_material(ck *c, const murk_plugin_desc *d)
             continue;
         }
         printf("  parameters: %s\n", set ? keys + 2 : "defaults");
-        mat_ref r;
+        mat_ref r, rin;
         memset(&r, 0, sizeof r);
         r.m = &s->materials[0].m;
         r.hit.t = 1.0f;
@@ -298,14 +460,22 @@ static void check_material(ck *c, const murk_plugin_desc *d)
         r.hit.u = r.hit.v = 0.5f;
         r.hit.material = r.m;
         r.hit.light = -1;
-        for (int w = 0; w < 3; w++) {
-            murk_vec3 wo = dir_of(thetas[w] * CK_PI / 180.0, 0.3);
-            snprintf(label, sizeof label, "set %d, wo %2.0f deg", set, thetas[w]);
-            check_chi2(c, &r, wo, label);
-            check_albedo(c, &r, wo, label);
-        }
+        rin = r; /* wo inside: the frame is flipped to wo's side, the shape's ng is not */
+        rin.hit.ng = murk_v3(0, 0, -1);
+        double eta[CK_MAX_ETA] = {0.0, 0.0, 0.0};
         snprintf(label, sizeof label, "set %d", set);
+        int transmits = learn_eta(c, &r, &rin, label, eta) > 0;
+        double eta_ch[3] = {0.0, 0.0, 0.0};
         check_reciprocity(c, &r, label);
+        if (transmits)
+            check_reciprocity_tr(c, &r, &rin, eta, label, eta_ch);
+        for (int side = 0; side < 1 + transmits; side++)
+            for (int w = 0; w < 3; w++) {
+                murk_vec3 wo = dir_of(thetas[w] * CK_PI / 180.0, 0.3);
+                snprintf(label, sizeof label, "set %d, wo %2.0f deg%s", set, thetas[w], side ? " inside" : "");
+                check_chi2(c, side ? &rin : &r, wo, label);
+                check_albedo(c, side ? &rin : &r, wo, transmits ? eta_ch : NULL, side, label);
+            }
         murk_scene_free(s);
     }
 }

@@ -600,7 +600,8 @@ static int write_npy(const char *path, const float *v, int w, int h)
     return fclose(f) == 0 ? 0 : -1;
 }
 
-/* Where the chart script is: beside the build tree's murk (build/tools/), else installed. */
+/* Where the chart script is: $MURK_BENCH_SCRIPT; beside the build tree's murk (build/tools/); where an
+ * install put it relative to bin/murk (so a relocated or --destdir install finds it); the install path. */
 static void script_path(char *buf, size_t n)
 {
     const char *env = getenv("MURK_BENCH_SCRIPT");
@@ -616,6 +617,9 @@ static void script_path(char *buf, size_t n)
         if (slash) {
             *slash = 0;
             snprintf(buf, n, "%s/../tools/bench_report.py", exe);
+            if (access(buf, R_OK) == 0)
+                return;
+            snprintf(buf, n, "%s/%s", exe, MURK_BENCH_SCRIPT_FROM_BINDIR);
             if (access(buf, R_OK) == 0)
                 return;
         }

@@ -182,7 +182,8 @@ static void *worker(void *arg)
                         continue;
                     }
                     acc[0] += L.c[0], acc[1] += L.c[1], acc[2] += L.c[2];
-                    peak = fmaxf(peak, fmaxf(fabsf(L.c[0]), fmaxf(fabsf(L.c[1]), fabsf(L.c[2]))));
+                    for (int c = 0; c < 3; c++) /* plain compares: fmaxf is a libm call here */
+                        peak = fabsf(L.c[c]) > peak ? fabsf(L.c[c]) : peak;
                     n++;
                 }
                 j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];

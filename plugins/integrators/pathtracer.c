@@ -22,8 +22,8 @@ const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
                            "most scattering events (surface or medium) per path"},
     [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000,
                           "scattering events before Russian roulette may end a path"},
-    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "solid_angle", "solid_angle|area", 0, 0,
-                                "NEE: rectangular lights by solid angle, or every light triangle by area"},
+    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0,
+                                "NEE: every light triangle by area, or rectangular lights by solid angle"},
     [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1,
                               "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
 };
@@ -58,7 +58,7 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->host = host;
     pt->max_depth = (int)params[MURK_PT_MAX_DEPTH].f[0];
     pt->rr_depth = (int)params[MURK_PT_RR_DEPTH].f[0];
-    pt->light_strategy = params[MURK_PT_LIGHT_SAMPLING].choice == 0 ? MURK_LIGHT_SOLID_ANGLE : MURK_LIGHT_AREA;
+    pt->light_strategy = params[MURK_PT_LIGHT_SAMPLING].choice == 1 ? MURK_LIGHT_SOLID_ANGLE : MURK_LIGHT_AREA;
     pt->rr_threshold = (float)params[MURK_PT_RR_THRESHOLD].f[0];
     pt->nee = nee;
     pt->media = media;

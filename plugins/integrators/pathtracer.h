@@ -43,7 +43,7 @@ typedef struct murk_pt {
     int max_depth, rr_depth;
     int nee;   /* sample lights at every scattering vertex */
     int media; /* track media (0: surfaces only, boundaries are invisible) */
-    int light_strategy; /* MURK_LIGHT_* for NEE and the MIS weight of emission found (0: area) */
+    int light_strategy; /* MURK_LIGHT_* for NEE and the MIS weight of emission found (0: area, the default) */
     float rr_threshold; /* Russian roulette's survival probability is min(1, weight / rr_threshold) (0: 1) */
 } murk_pt;
 

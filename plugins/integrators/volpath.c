@@ -5,14 +5,15 @@
  * Parameters
  *   max_depth  int in [1, 100000], default 64: most scattering events (surface or medium) per path.
  *   rr_depth   int in [0, 100000], default 3: events before Russian roulette may end a path.
- *   light_sampling  solid_angle | area, default solid_angle: how next-event estimation picks a point on
- *              a light: a rectangular quad or box face uniformly in the solid angle it subtends (Urena et
- *              al. 2013; tiny ones and other shapes as with area), or every emitting triangle uniformly
- *              by area (murk before ABI 1.4). The same image either way; solid_angle is less noisy near
- *              lights.
+ *   light_sampling  area | solid_angle, default area: how next-event estimation picks a point on a
+ *              light: every emitting triangle uniformly by area, or a rectangular quad or box face
+ *              uniformly in the solid angle it subtends (Urena et al. 2013; tiny ones and other shapes
+ *              by area). solid_angle is far less noisy for points close to a light, but costs more per
+ *              sample and did not lower the error of whole images (docs/results.md).
  *   rr_threshold  float in [0.001, 1], default 1: Russian roulette keeps a path with probability
  *              min(1, weight / rr_threshold) (at least 0.05): 1 plays with every path whose weight fell
- *              below 1, 0.1 only with the paths below a tenth (longer paths, less noise per sample).
+ *              below 1, 0.1 only with the paths below a tenth (longer paths, less noise per sample, no
+ *              better per second: docs/results.md).
  *
  * Works with every tracker; see pathtracer.h (pathtracer.c) for how media, boundaries and spectral MIS weights
  * are handled. */

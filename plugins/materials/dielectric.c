@@ -16,6 +16,11 @@
  *              height-correlated Smith masking-shadowing, visible-normal sampling (Dupuy & Benyoub 2023).
  *   tint       RGB in [0, 1], default 1. Multiplies transmitted light at each crossing (a thin coloured
  *              film; the colour of a thick body belongs in a medium: `interior:`).
+ *   multiscatter  bool, default true. Rough only: multiple-scattering energy compensation (below), so that
+ *              a rough interface without absorption loses no light; false gives the single-scattering
+ *              model exactly as before it existed (for A/B: at roughness 1 it keeps 0.31 of the energy
+ *              arriving from inside an ior 2.4 body at normal incidence, and a rough ior 1.5 sphere in a
+ *              white furnace renders 0.36 instead of 1).
  *
  * Model (pbrt-v4's DielectricBxDF, in murk's oriented frame: +z = the shading normal = outside; wo.z < 0
  * is wo inside). eta = ior per channel; etap = eta_wi / eta_wo (eta when wo is outside and wi inside,
@@ -32,6 +37,16 @@
  *           D_wo(wm) T |wi.wm| / (wi.wm + wo.wm / etap)^2, D_wo(wm) = G1(wo) D(wm) |wo.wm| / |wo.z|.
  *           Microfacets facing away from wo or wi are discarded (f = pdf = 0); samples that reflect
  *           through the surface or refract back to wo's side are rejected (sample() returns 0).
+ * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, their dielectric extension):
+ *           the single-scattering model's energy albedo E_s(mu) (reflection + transmission, the latter as
+ *           energy: radiance x etap^2; s = the side wo is on) falls short of 1 because microfacets shadow
+ *           and mask each other; a compensation lobe adds exactly the missing 1 - E_s(mu_o), split between
+ *           reflection and transmission so that both sides conserve energy and transmission stays
+ *           reciprocal (derivation at ms_prepare). E is tabulated per side over (mu, alpha, eta) by
+ *           tools/ggx_tables.c (dielectric_tables.h; its axes in dielectric_tables_axis.h); create()
+ *           blends the two nearest eta nodes' rows for its ior and averages them exactly. The lobe is
+ *           sampled with probability 1 - E_s(mu_o), cosine-weighted on the chosen side; pdf() is the
+ *           mixture. With dispersion every channel has its own tables.
  * Transport mode: radiance. murk's integrators trace from the camera and carry radiance, so a
  * transmitted f includes (eta_wo / eta_wi)^2 — radiance is compressed into the denser medium. The
  * reciprocity that holds is eval(wo, wi) / eta_wo^2 = eval(wi, wo) / eta_wi^2. sample() reports
@@ -43,7 +58,7 @@
 
 #include <string.h>
 
-enum { P_IOR, P_ROUGHNESS, P_TINT, P_COUNT };
+enum { P_IOR, P_ROUGHNESS, P_TINT, P_MULTISCATTER, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_IOR] = {"ior", MURK_PARAM_RGB, 0, {1.5, 1.5, 1.5}, NULL, NULL, 1.0, 4.0,
@@ -52,16 +67,33 @@ static const murk_param params[P_COUNT] = {
                      "0: smooth (delta lobes); > 0: GGX with alpha = roughness^2 (>= 0.001)"},
     [P_TINT] = {"tint", MURK_PARAM_RGB, MURK_PARAM_TEXTURABLE, {1.0, 1.0, 1.0}, NULL, NULL, 0.0, 1.0,
                 "multiplies transmitted light at each crossing"},
+    [P_MULTISCATTER] = {"multiscatter", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
+                        "rough: multiple-scattering compensation (Kulla & Conty 2017); false: single scattering"},
 };
 
 #define DI_MU_MIN 1e-9f
-#define DI_ALPHA_MIN 1e-3f
+
+/* di_e: E(mu, alpha, eta) of the single-scattering model, outside and inside, with DI_TAB_NMU, DI_TAB_NR,
+ * DI_TAB_NETA and DI_ALPHA_MIN (the alpha clamp the tables assume); tools/ggx_tables.c writes it. */
+#include "dielectric_tables.h"
+
+/* The compensation's tables for one index eta, built at create(): E per side (0: wo outside, 1: inside)
+ * and roughness row on the row's own mu axis (tools/ggx_tables.c, di_u_of_mu), the rows of the two
+ * nearest eta nodes blended; each row's exact average; Favg, the outside's hemispherical Fresnel average. */
+typedef struct di_ms {
+    float e[2][DI_TAB_NR][DI_TAB_NMU];
+    float avg[2][DI_TAB_NR];
+    float mc;   /* cosine of the critical angle inside */
+    float favg; /* integral of F(mu, eta) 2 mu dmu from outside */
+} di_ms;
 
 typedef struct dielectric {
     const murk_host *host;
     murk_value p[P_COUNT];
     float eta[3];
     int dispersive; /* the channels' indices differ */
+    int ms;         /* multiple-scattering compensation */
+    di_ms tab[3];   /* per channel (only [0] when not dispersive) */
 } dielectric;
 
 typedef struct di_shade {
@@ -150,47 +182,138 @@ static murk_vec3 sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
 
 static int usable(float z) { return fabsf(z) >= DI_MU_MIN; } /* NaN -> 0 */
 
-/* Rough lobes for one index eta: f (without tint) into *f, pdf into *pdf. Returns 0 when both are 0. */
-static int rough_one(float eta, float alpha, murk_vec3 wo, murk_vec3 wi, float *f, float *pdf, int *trans)
+/* ---- Multiple-scattering compensation ---------------------------------------------------------- */
+#include "dielectric_tables_axis.h"
+
+static float ms_alpha(int j)
+{
+    float r = (float)j / (float)(DI_TAB_NR - 1);
+    return murk_maxf(r * r, DI_ALPHA_MIN);
+}
+
+/* E(mu) of row j on side `side` */
+static float ms_row(const di_ms *t, int side, int j, float mu)
+{
+    float u = (float)di_u_of_mu(side, mu, ms_alpha(j), t->mc) * (float)(DI_TAB_NMU - 1);
+    int i = (int)u;
+    i = i > DI_TAB_NMU - 2 ? DI_TAB_NMU - 2 : (i < 0 ? 0 : i);
+    const float *row = t->e[side][j];
+    return row[i] + (row[i + 1] - row[i]) * (u - (float)i);
+}
+
+/* The compensation at one wo for one index: its probability of being sampled (1 - E(mu_o)), the share of
+ * it that reflects (r) and the constants of its two lobes. */
+typedef struct ms_at {
+    int j;           /* roughness row, blended with j + 1 by fr */
+    float fr;
+    float one_eo;    /* 1 - E(mu_o) */
+    float r;         /* reflected share of the compensation's energy, on wo's side */
+    float kr, kt;    /* f = kr (1 - E_o)(1 - E_i) (reflection), kt (1 - E_o)(1 - E_i) [/ eta^2 from outside] */
+} ms_at;
+
+/* 1 - E(mu) on side `side` at m's roughness */
+static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
+{
+    float e0 = ms_row(t, side, m->j, mu), e1 = ms_row(t, side, m->j + 1, mu);
+    return clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
+}
+
+/* The lobe (Kulla & Conty 2017's dielectric extension). Sides: o outside (index 1), i inside (index
+ * eta); E_o, E_i the single-scattering energy albedos seen from each side (tables), A_s = 1 - Eavg_s their
+ * averages' shortfalls, Favg = integral of F(mu, eta) 2 mu dmu from outside. For wo on side s, wi on s':
+ *   reflection    f = r_s (1 - E_s(mu_o)) (1 - E_s(mu_i)) / (pi A_s)
+ *   transmission  f = t_s eta_s^2 / (eta_s'^2 pi A_s') (1 - E_s(mu_o)) (1 - E_s'(mu_i)),  t_s = 1 - r_s.
+ * Energy: the reflection lobe returns r_s (1 - E_s(mu_o)), the transmission lobe (its radiance albedo
+ * times (eta_s' / eta_s)^2) t_s (1 - E_s(mu_o)): together exactly the single-scattering model's loss, so
+ * the compensated albedo is E_s + 1 - E_s = 1 for any split. Reciprocity, f(a, b) / eta_a^2 =
+ * f(b, a) / eta_b^2 (murk/material.h): reflection is symmetric; transmission needs
+ * t_o / (eta^2 A_i) = t_i / A_o, i.e. t_o A_o = eta^2 t_i A_i — the transmitted compensation energy
+ * crossing each way balances, as Fresnel's own 1 - Favg(1 / eta) = (1 - Favg(eta)) / eta^2 does for a
+ * smooth interface. Kulla & Conty's split satisfies it with one fraction x shared by both sides:
+ *   t_o = (1 - Favg) x,  t_i = (1 - Favg) (1 - x) / eta^2,  x = A_i / (A_o + A_i),
+ * which is in [0, 1 - Favg] and [0, (1 - Favg) / eta^2]: both sides' shares are valid. Then
+ *   transmission f = kt (1 - E_s(mu_o)) (1 - E_s'(mu_i)) / eta^2 from outside, kt (...) from inside,
+ *        kt = (1 - Favg) / (pi (A_o + A_i)): f(o, i) / 1 = f(i, o) / eta^2 (reciprocal),
+ *   reflection   f = kr (1 - E_s(mu_o)) (1 - E_s(mu_i)), kr = r_s / (pi A_s), r_o = 1 - t_o, r_i = 1 - t_i.
+ * It is sampled with probability 1 - E_s(mu_o) (the energy it carries), then reflection with
+ * probability r_s, else transmission, the direction cosine-weighted on that side. */
+static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float mu_o, ms_at *m)
+{
+    float r = sqrtf(alpha) * (float)(DI_TAB_NR - 1);
+    int j = (int)r;
+    m->j = j > DI_TAB_NR - 2 ? DI_TAB_NR - 2 : j;
+    m->fr = r - (float)m->j;
+    m->one_eo = ms_one_e(t, m, side, mu_o);
+    float ao = 1.0f - (t->avg[0][m->j] + (t->avg[0][m->j + 1] - t->avg[0][m->j]) * m->fr);
+    float ai = 1.0f - (t->avg[1][m->j] + (t->avg[1][m->j + 1] - t->avg[1][m->j]) * m->fr);
+    float as = side ? ai : ao, sum = ao + ai, tf = 1.0f - t->favg;
+    if (!(sum > 1e-7f)) { /* (numerically) no loss to compensate on either side */
+        m->one_eo = m->r = m->kr = m->kt = 0.0f;
+        return;
+    }
+    float ts = side ? tf * ao / (eta * eta * sum) : tf * ai / sum;
+    m->r = clamp01(1.0f - ts);
+    m->kr = as > 1e-7f ? m->r / (MURK_PI * as) : 0.0f; /* kt alone keeps transmission reciprocal */
+    m->kt = tf / (MURK_PI * sum);
+}
+
+/* Rough lobes for one index eta: f (without tint) into *f, pdf into *pdf; ms (may be NULL): the
+ * compensation's tables for eta. Returns 0 when both are 0. */
+static int rough_one(const di_ms *ms, float eta, float alpha, murk_vec3 wo, murk_vec3 wi, float *f, float *pdf, int *trans)
 {
     *f = *pdf = 0.0f;
     float co = wo.z, ci = wi.z;
     int reflect = co * ci > 0.0f;
     float etap = reflect ? 1.0f : (co > 0.0f ? eta : 1.0f / eta);
     *trans = !reflect;
+    float a2 = alpha * alpha;
     murk_vec3 wm = murk_add(murk_mul(wi, etap), wo);
     float l2 = murk_dot(wm, wm);
-    if (!(l2 > 1e-12f))
-        return 0;
-    wm = murk_mul(wm, 1.0f / sqrtf(l2));
-    if (wm.z < 0.0f)
-        wm = murk_neg(wm);
-    float dwi = murk_dot(wm, wi), dwo = murk_dot(wm, wo);
-    if (dwi * ci <= 0.0f || dwo * co <= 0.0f)
-        return 0;
-    float a2 = alpha * alpha;
-    float D = ggx_D(wm, a2);
-    /* a transmitted pair's Fresnel from the outside direction's cosine, whichever of wo and wi it is: the
-     * same number as from inside, but without the cancellation in 1 - sin^2 near the critical angle, so
-     * f stays reciprocal to float precision */
-    float F = fresnel(reflect || co > 0.0f ? dwo : dwi, eta);
-    float dwo_pdf = g1_over(co, a2) * D * fabsf(dwo); /* D_wo(wm) */
-    if (reflect) {
-        *f = D * F * 0.25f * g2_over(co, ci, a2);
-        *pdf = dwo_pdf * F / (4.0f * fabsf(dwo));
-    } else {
-        float s = dwi + dwo / etap, den = s * s;
-        if (!(den > 0.0f))
-            return 0;
-        float T = 1.0f - F;
-        *f = D * T * g2_over(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
-        *pdf = dwo_pdf * T * fabsf(dwi) / den;
+    if (l2 > 1e-12f) { /* single scattering */
+        wm = murk_mul(wm, 1.0f / sqrtf(l2));
+        if (wm.z < 0.0f)
+            wm = murk_neg(wm);
+        float dwi = murk_dot(wm, wi), dwo = murk_dot(wm, wo);
+        if (dwi * ci > 0.0f && dwo * co > 0.0f) {
+            float D = ggx_D(wm, a2);
+            /* a transmitted pair's Fresnel from the outside direction's cosine, whichever of wo and wi it
+             * is: the same number as from inside, but without the cancellation in 1 - sin^2 near the
+             * critical angle, so f stays reciprocal to float precision */
+            float F = fresnel(reflect || co > 0.0f ? dwo : dwi, eta);
+            float dwo_pdf = g1_over(co, a2) * D * fabsf(dwo); /* D_wo(wm) */
+            if (reflect) {
+                *f = D * F * 0.25f * g2_over(co, ci, a2);
+                *pdf = dwo_pdf * F / (4.0f * fabsf(dwo));
+            } else {
+                float s = dwi + dwo / etap, den = s * s;
+                if (den > 0.0f) {
+                    float T = 1.0f - F;
+                    *f = D * T * g2_over(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
+                    *pdf = dwo_pdf * T * fabsf(dwi) / den;
+                }
+            }
+        }
+    }
+    if (ms) { /* the compensation lobe, mixed into the pdf with its sampling probability */
+        ms_at m;
+        int so = co < 0.0f, si = ci < 0.0f;
+        ms_prepare(ms, alpha, eta, so, fabsf(co), &m);
+        float k = m.one_eo * ms_one_e(ms, &m, si, fabsf(ci));
+        float cos_pdf = fabsf(ci) * MURK_INV_PI;
+        *pdf *= 1.0f - m.one_eo;
+        if (reflect) {
+            *f += m.kr * k;
+            *pdf += m.one_eo * m.r * cos_pdf;
+        } else {
+            *f += so ? m.kt * k : m.kt * k / (eta * eta);
+            *pdf += m.one_eo * (1.0f - m.r) * cos_pdf;
+        }
     }
     if (!isfinite(*f) || !isfinite(*pdf)) {
         *f = *pdf = 0.0f;
         return 0;
     }
-    return 1;
+    return *f > 0.0f || *pdf > 0.0f;
 }
 
 /* eval and pdf together: f per channel, pdf averaged over the channels when dispersive. */
@@ -207,7 +330,7 @@ static float rough_eval(const dielectric *d, const di_shade *sh, murk_vec3 wo, m
             continue;
         }
         float fc, pc;
-        rough_one(d->eta[c], sh->alpha, wo, wi, &fc, &pc, &trans);
+        rough_one(d->ms ? &d->tab[c] : NULL, d->eta[c], sh->alpha, wo, wi, &fc, &pc, &trans);
         f->c[c] = fc;
         pdf += pc;
     }
@@ -216,6 +339,34 @@ static float rough_eval(const dielectric *d, const di_shade *sh, murk_vec3 wo, m
     if (trans)
         *f = murk_rgb_mul(*f, sh->tint);
     return pdf * (1.0f / 3.0f);
+}
+
+/* The compensation's tables for index eta (in [1, 4]): the rows of the two nearest eta nodes blended on
+ * the aligned axis (dielectric_tables_axis.h), their exact averages, and Favg by a midpoint rule in mu^2
+ * (F is smooth from outside; 4096 points: error < 1e-7). */
+static void ms_build(di_ms *t, double eta)
+{
+    double x = sqrt(fmax(0.0, (eta - 1.0) / 3.0)) * (DI_TAB_NETA - 1);
+    int k = (int)x;
+    k = k > DI_TAB_NETA - 2 ? DI_TAB_NETA - 2 : k;
+    double fx = x - k, mc = di_mucrit(eta);
+    t->mc = (float)mc;
+    for (int side = 0; side < 2; side++)
+        for (int j = 0; j < DI_TAB_NR; j++) {
+            double row[DI_TAB_NMU];
+            const float *r0 = &di_e[((side * DI_TAB_NETA + k) * DI_TAB_NR + j) * DI_TAB_NMU];
+            const float *r1 = r0 + DI_TAB_NR * DI_TAB_NMU;
+            for (int i = 0; i < DI_TAB_NMU; i++) {
+                row[i] = r0[i] + ((double)r1[i] - r0[i]) * fx;
+                t->e[side][j][i] = (float)row[i];
+            }
+            t->avg[side][j] = (float)di_row_avg(row, DI_TAB_NMU, side, ms_alpha(j), mc);
+        }
+    double sum = 0.0;
+    enum { NF = 4096 };
+    for (int i = 0; i < NF; i++) /* integral of F d(mu^2) */
+        sum += fresnel(sqrtf((float)((i + 0.5) / NF)), (float)eta);
+    t->favg = (float)(sum / NF);
 }
 
 /* ---- Plugin interface ---------------------------------------------------------------------- */
@@ -231,6 +382,9 @@ static int di_create(const murk_host *host, const murk_value *p, void **self, ch
     for (int c = 0; c < 3; c++)
         d->eta[c] = (float)p[P_IOR].f[c];
     d->dispersive = d->eta[0] != d->eta[1] || d->eta[1] != d->eta[2];
+    d->ms = p[P_MULTISCATTER].f[0] != 0.0;
+    for (int c = 0; d->ms && c < (d->dispersive ? 3 : 1); c++)
+        ms_build(&d->tab[c], p[P_IOR].f[c]);
     *self = d;
     return 0;
 }
@@ -328,20 +482,36 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
         s->delta = 1;
         return murk_rgb_finite(s->f) && isfinite(s->pdf);
     }
-    /* rough: a visible normal of wo (of -wo when wo is inside) */
-    murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
-    murk_vec3 wm = sample_vndf(wv, sh.alpha, u[0], u[1]);
-    float R = fresnel(murk_dot(wo, wm), eta);
     murk_vec3 wi;
-    if (uc < R) {
-        wi = murk_normalize(murk_sub(murk_mul(wm, 2.0f * murk_dot(wo, wm)), wo));
-        if (wi.z * wo.z <= 0.0f)
-            return 0;
-    } else {
-        float etap;
-        if (!refract(wo, wm, eta, &etap, &wi) || wi.z * wo.z >= 0.0f)
-            return 0;
-        s->eta = etap;
+    int lobe_ms = 0;
+    if (d->ms) { /* the compensation lobe with probability 1 - E(mu_o) (see ms_prepare) */
+        ms_at m;
+        ms_prepare(&d->tab[ch], sh.alpha, eta, wo.z < 0.0f, fabsf(wo.z), &m);
+        if (uc < m.one_eo) {
+            lobe_ms = 1;
+            float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1], z = sqrtf(murk_maxf(0.0f, 1.0f - u[0]));
+            int same = uc / m.one_eo < m.r; /* reflection: wo's side */
+            wi = murk_v3(r * cosf(phi), r * sinf(phi), (wo.z > 0.0f) == same ? z : -z);
+            if (!same)
+                s->eta = wo.z > 0.0f ? eta : 1.0f / eta;
+        } else {
+            uc = (uc - m.one_eo) / (1.0f - m.one_eo);
+        }
+    }
+    if (!lobe_ms) { /* a visible normal of wo (of -wo when wo is inside), then Fresnel's choice */
+        murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
+        murk_vec3 wm = sample_vndf(wv, sh.alpha, u[0], u[1]);
+        float R = fresnel(murk_dot(wo, wm), eta);
+        if (uc < R) {
+            wi = murk_normalize(murk_sub(murk_mul(wm, 2.0f * murk_dot(wo, wm)), wo));
+            if (wi.z * wo.z <= 0.0f)
+                return 0;
+        } else {
+            float etap;
+            if (!refract(wo, wm, eta, &etap, &wi) || wi.z * wo.z >= 0.0f)
+                return 0;
+            s->eta = etap;
+        }
     }
     if (!usable(wi.z))
         return 0;
@@ -359,5 +529,6 @@ static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, di_create, di_destroy, di_eval, di_pdf, di_sample,
 };
 
-MURK_MATERIAL_PLUGIN("dielectric", "smooth or rough (GGX) dielectric: reflection, refraction, TIR; RGB dispersion",
+MURK_MATERIAL_PLUGIN("dielectric",
+                     "smooth or rough (GGX, energy-compensated) dielectric: reflection, refraction, TIR; RGB dispersion",
                      params, P_COUNT, &vt)

@@ -98,7 +98,7 @@ typedef struct murk_rng {
     uint32_t sampler;  /* MURK_SAMPLER_* */
     uint32_t index;    /* the sample's index within its pixel */
     uint32_t dim;      /* the next slot */
-    uint32_t pad_;
+    uint32_t rindex;   /* index with its bits reversed */
 } murk_rng;
 
 static inline uint64_t murk_hash64(uint64_t x)
@@ -126,21 +126,10 @@ static inline void murk_rng_seed(murk_rng *r, uint64_t a, uint64_t b, uint64_t c
     murk_rng_u32(r);
     r->scramble = 0u;
     r->sampler = MURK_SAMPLER_INDEPENDENT;
-    r->index = r->dim = r->pad_ = 0u;
+    r->index = r->dim = r->rindex = 0u;
 }
 /* Uniform float in [0, 1): 24 random mantissa bits, never 1. */
 static inline float murk_rng_float(murk_rng *r) { return (float)(murk_rng_u32(r) >> 8) * (1.0f / 16777216.0f); }
-
-/* The stream of sample `index` of pixel `pixel` for a render seeded with `seed`, drawing its slots
- * with `sampler` (MURK_SAMPLER_*) from slot 0. What the core does before every sample. */
-static inline void murk_sampler_start(murk_rng *r, uint32_t sampler, uint64_t seed, uint64_t pixel, uint32_t index)
-{
-    murk_rng_seed(r, seed, pixel, index);
-    r->scramble = murk_hash64(murk_hash64(seed ^ 0x5851f42d4c957f2dull) ^ pixel);
-    r->sampler = sampler;
-    r->index = index;
-}
-static inline void murk_sample_seek(murk_rng *r, uint32_t slot) { r->dim = slot; }
 
 static inline uint32_t murk_reverse_bits32(uint32_t x)
 {
@@ -150,33 +139,50 @@ static inline uint32_t murk_reverse_bits32(uint32_t x)
     x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
     return (x >> 16) | (x << 16);
 }
-/* A nested uniform (Owen) scramble of the bits of x, most significant first: each bit is flipped by a
- * hash of the bits above it (Laine-Karras style hash on the reversed bits, with Vegdahl's constants). */
-static inline uint32_t murk_owen_scramble(uint32_t x, uint32_t seed)
+
+/* The stream of sample `index` of pixel `pixel` for a render seeded with `seed`, drawing its slots
+ * with `sampler` (MURK_SAMPLER_*) from slot 0. What the core does before every sample. */
+static inline void murk_sampler_start(murk_rng *r, uint32_t sampler, uint64_t seed, uint64_t pixel, uint32_t index)
 {
-    x = murk_reverse_bits32(x);
+    murk_rng_seed(r, seed, pixel, index);
+    r->scramble = murk_hash64(murk_hash64(seed ^ 0x5851f42d4c957f2dull) ^ pixel);
+    r->sampler = sampler;
+    r->index = index;
+    r->rindex = murk_reverse_bits32(index);
+}
+static inline void murk_sample_seek(murk_rng *r, uint32_t slot) { r->dim = slot; }
+
+/* Sobol dimension 1 is Pascal's matrix mod 2: output bit j (from the top) is the XOR of the index bits
+ * k (from the bottom) with j a subset of k (Lucas). That is a superset-sum over the 5-bit positions,
+ * five shift-xor steps; the result has output bit j at position j, i.e. it is reversed. */
+static inline uint32_t murk_sobol1_reversed(uint32_t i)
+{
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
+}
+/* A nested uniform (Owen) scramble of the bits of x, most significant first, is reverse(lk(reverse(x))):
+ * lk flips each bit by a hash of the bits below it (Laine-Karras style, Vegdahl's constants). */
+static inline uint32_t murk_lk_hash_(uint32_t x, uint32_t seed)
+{
     x ^= x * 0x3d20adeau;
     x += seed;
     x *= (seed >> 16) | 1u;
     x ^= x * 0x05526c56u;
     x ^= x * 0x53a22864u;
-    return murk_reverse_bits32(x);
-}
-/* Sobol dimension 1 (Pascal's matrix); dimension 0 is murk_reverse_bits32. */
-static inline uint32_t murk_sobol1(uint32_t i)
-{
-    uint32_t x = 0u;
-    for (uint32_t v = 0x80000000u; i; i >>= 1, v ^= v >> 1)
-        if (i & 1u)
-            x ^= v;
     return x;
 }
-/* Sobol coordinate 0 of the next slot's shuffled index; *i gets that index and *h the slot's hash. */
+/* The next slot's shuffled sample index i (an Owen scramble of the index, which keeps every block of
+ * 2^k consecutive indices a (0, k, 2)-net) and its scrambled Sobol coordinate 0; *h gets the slot's
+ * hash. owen(sobol0(i)) = reverse(lk(i)) since sobol0 is the bit reversal. */
 static inline uint32_t murk_sample_slot_(murk_rng *r, uint32_t *i, uint64_t *h)
 {
     *h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(r->dim++ + 1u));
-    *i = murk_owen_scramble(r->index, (uint32_t)*h);
-    return murk_owen_scramble(murk_reverse_bits32(*i), (uint32_t)(*h >> 32));
+    *i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)*h));
+    return murk_reverse_bits32(murk_lk_hash_(*i, (uint32_t)(*h >> 32)));
 }
 static inline float murk_u24_(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
 /* The next slot as a point in [0, 1)^2 (24 bits each, never 1). */
@@ -190,7 +196,7 @@ static inline void murk_sample_2d(murk_rng *r, float u[2])
     uint32_t i;
     uint64_t h;
     u[0] = murk_u24_(murk_sample_slot_(r, &i, &h));
-    u[1] = murk_u24_(murk_owen_scramble(murk_sobol1(i), (uint32_t)murk_hash64(h)));
+    u[1] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_sobol1_reversed(i), (uint32_t)murk_hash64(h))));
 }
 /* The next slot as one number in [0, 1). */
 static inline float murk_sample_1d(murk_rng *r)
