@@ -120,14 +120,17 @@ def repair_section(meta):
             L.append("| %s | %s | %.3g | %.2f |" % (r["scene"], r["variant"], r["relmse"], r["seconds"]))
         L.append("")
     L.append(
-        "Before these repairs (murk at commit e2aa582, the same renders and reference, measured once by hand): "
+        "Before these repairs (murk at commit e2aa582, before the Sobol sampler, the same renders against a "
+        "256-spp reference of that time, measured once by hand; the bounding rows then: 1.36e-2 and 1.33e-2): "
         "cornell_smoke delta at majorant_factor 0.9 / 0.5 / 0.25: 1.41e-2 / 1.05e20 / 1.72e23; decomposition at "
         "control 1.5 / 5 / 10: 0.334 / 9.1e42 / 1.7e48; spectral_extinction spectral at factor 0.5 / 0.25: "
         "5.4e23 / 1.1e23, spectral_mis at 0.25: 2.1e29, delta at 0.25: 7.8e40, decomposition at control 10: "
         "8.4e41. With the repairs every one of these equals its bounding case (bitwise the same image). "
-        "Without them (the diagnosis mode) the per-flight raise helps at factor 0.5 (2.1e15 against 1.05e20) "
-        "but not everywhere: decomposition at control 1.5 with `repair: false` measured 9.1 against 0.33 "
-        "before (over seeds 1-3: 1.9 / 13 / 7.2 against 0.33 / 5.5 / 0.98) — single renders of such "
+        "Without them (the diagnosis mode) the per-flight raise helps at factor 0.5 (2e15 and 3e16 in two runs, "
+        "against 1.05e20) "
+        "but not everywhere: decomposition at control 1.5 with `repair: false` measured 9.1 (3.5 in this run, "
+        "with murk's Sobol sampler) against 0.33 before (over seeds 1-3: 1.9 / 13 / 7.2 against 0.33 / 5.5 / "
+        "0.98) — single renders of such "
         "heavy-tailed estimators vary by 10x between seeds, and the cause of that difference is not found; "
         "keep the repairs on.")
     L.append("")
@@ -138,13 +141,13 @@ FINDINGS = [
     "## Three surprises", "",
     "1. **The baseline's noise is everywhere, not just in the medium.** `naive_spectral` carries one channel per "
     "path on every path, so a background seen through an almost empty medium (density 1e-4) gets full colour "
-    "noise: 1e5 to 1e7 times delta's cost for the same error, the largest gap in the atlas — at the point where "
+    "noise: 1e6 to 1e7 times delta's cost for the same error, the largest gap in the atlas — at the point where "
     "the medium hardly matters.",
     "2. **A majorant 4x too low is no longer a problem; one 32x too high costs the shadow estimators most.** "
     "With the load-time repair, `majorant_factor` 0.25 renders bitwise the image of factor 1. At factor 32 "
-    "the trackers keep pace with delta, but `power_series` shadow rays fall to 0.02-0.09 of delta's "
-    "efficiency and track length to 0.3-0.4, while residual ratio tracking stays at 0.7-0.9. Without the "
-    "repair, the homogeneous box is worse off than the cloud (1.5-3% fireflies against 1e-4): in a "
+    "the trackers and the other shadow estimators stay within the timing noise of delta, but `power_series` "
+    "falls to about 0.1 of delta's efficiency (0.07-0.18 per lookup). Without the repair, the homogeneous box "
+    "is worse off than the cloud (1.4-3% fireflies against 1e-4 or less): in a "
     "constant density every tentative collision violates, in the cloud only the dense parts do, and one "
     "violation per flight is enough to spoil a path with many flights.",
     "3. **The one significant bias is in a transmittance estimator at the density extreme.** Every tracker is "
@@ -166,8 +169,11 @@ METHODS = [
      "absorbed), so a thick absorber viewed head-on shows rare bright samples (the fireflies of the absorber "
      "sweep). murk warns about nothing here; pick it unless a row below says otherwise."),
     ("decomposition", "Decomposition tracking: a closed-form control (the cell's minimum density) plus a tracked "
-     "residual. It matches delta everywhere and wins where the minorant is close to the majorant (the homogeneous "
-     "box at very low density, a coarse `majorant_resolution` on the cloud does not hurt it more than delta). "
+     "residual. It matches delta within the timing noise nearly everywhere (in this scene family the cloud's "
+     "minorant is 0 in most cells, so the control rarely has anything to take), and a coarse "
+     "`majorant_resolution` does not hurt it more than delta. On the homogeneous box the control takes every "
+     "collision and it looks the density up almost never: 400x delta's efficiency per lookup (the time-based "
+     "figure hides that here, because a constant density costs little to look up). "
      "`control` > 1 used to be its failure mode (relMSE 1e43); it is now clamped at load (`repair`), so the "
      "control sweep is flat. With `repair: false` it weights the violating residual collisions and lowers the "
      "flight's control: unbiased, but the noisiest points of the whole atlas (`control_norepair` on the "
@@ -176,10 +182,9 @@ METHODS = [
      "is tight; keep `repair` on."),
     ("spectral", "Spectral tracking (Kutz et al. 2017) with history-aware probabilities: one flight for all "
      "channels, absorption sampled as a path end. On grey media it is strictly worse than delta (it kills paths "
-     "at absorption events where delta weights them: a median 3.4x delta's variance over the grey points, up "
-     "to 20x), and it loses most on the thin cloud. Its weights stay bounded up to chroma 1:1000 (no NaN, no "
-     "fireflies), and with the majorant repair off its single samples grow largest (max/mean 2.6e5 at factor "
-     "0.25). murk says nothing; pick "
+     "at absorption events where delta weights them: about 3x delta's variance at the median grey point, "
+     "up to 30x), and it loses most on the thin media (density 1e-4: 0.01-0.03 of delta's efficiency). Its "
+     "weights stay bounded up to chroma 1:1000 (no NaN, no fireflies). murk says nothing; pick "
      "`delta` (the same per-channel weighting without the absorption lottery) or `spectral_mis`."),
     ("spectral_mis", "Spectral MIS (Miller et al. 2019): hero-channel tracking with the balance heuristic over "
      "channels. On grey media it is delta tracking bit for bit (same samples, same image); on chromatic media it "
@@ -187,7 +192,7 @@ METHODS = [
      "tracker of this atlas for that reason. Pick it for strongly chromatic media."),
     ("naive_spectral", "Per-channel delta tracking, one channel per path: the baseline. It carries one channel "
      "with weight 3 on every path, also on paths that never meet the medium, so it puts colour noise on the "
-     "background seen through a nearly empty medium (efficiency 1e-5..1e-7 of delta at density 1e-4) and loses "
+     "background seen through a nearly empty medium (efficiency 1e-6..1e-7 of delta at density 1e-4) and loses "
      "10x to 100x on every grey or mildly chromatic point. It is unbiased everywhere. Only at 1:1000 chroma does "
      "it approach the others. Use it to measure the others, not to render."),
     ("delta+ratio", "Plain ratio tracking for shadow rays: unbiased and bounded for a bounding majorant; it pays "
@@ -200,12 +205,14 @@ METHODS = [
      "loose (`majorant_factor` 32)."),
     ("delta+unbiased_raymarch", "Unbiased ray marching (Kettunen et al. 2021): fine at moderate density, but its "
      "march cost follows the optical depth: at density 1e4 it is 100x slower than delta for the same noise, and "
-     "on the almost empty cloud (density 1e-4) it adds noise where every other estimator is exact."),
+     "on the almost empty cloud (density 1e-4) it adds noise where every other estimator is exact (30x worse "
+     "per lookup there)."),
     ("delta+power_series", "The cumulative power-series estimator: comparable to ratio tracking up to density "
-     "100, but at density 1e4 in the cloud the image comes out 5% dark (z about -18, reproduced with two more "
-     "seeds and with `--threads 1`, bitwise the same) — a bug this atlas found and that is not fixed yet. What "
-     "is known: the deficit sits on the lit top of the cloud; the renders have more zero samples (33% against "
-     "28%); `chunk_depth` 32 halves it, 1 does not; yet its transmittance along 3000 shadow rays from first "
+     "100, but at density 1e4 in the cloud the image comes out 5% dark (z -18 and -20 in two runs of the atlas, "
+     "reproduced with two more seeds and with `--threads 1`, bitwise the same) — a bug this atlas found and that "
+     "is not fixed yet. What is known (from a run before murk's Sobol sampler): the deficit sits on the lit top "
+     "of the cloud; the renders have more zero samples (33% against 28%); `chunk_depth` 32 halves it, 1 does "
+     "not; yet its transmittance along 3000 shadow rays from first "
      "collisions near the cloud's surface agrees with ratio tracking (sums 962.04 and 961.92 over 400 estimates "
      "each), so the cause is not yet located. It is opt-in; avoid it for very dense media until then."),
 ]
@@ -273,11 +280,13 @@ def write(root, meta, rows, sweep_doc, prose=None):
              "extreme points in seconds; `meson test -C build --setup stability --suite stability` runs the "
              "whole atlas with `--check`). Do not edit by hand: edit `bench/stability/atlas_doc.py`.")
     L.append("")
-    L.append("This run: %d renders of %dx%d pixels at %d spp (references: %d spp), %.1f minutes on a shared "
+    L.append("This run: %d renders of %dx%d pixels at %d spp (references: %d spp), %.1f minutes (%.1f with the "
+             "relMSE renders of the next section) on a shared "
              "2-core machine (times, and so efficiencies, carry the noise of that load: read factors of 2, not "
              "percent). **Non-finite samples: %d in all.** Largest |bias z|: %.2f (%s, %s, %s = %s). Highest "
              "firefly rate: %.3g (%s, %s, %s = %s)."
-             % (len(rows), meta["res"], meta["res"], meta["spp"], meta["ref_spp"], meta["minutes"], nonfinite,
+             % (len(rows), meta["res"], meta["res"], meta["spp"], meta["ref_spp"], meta["minutes"],
+                meta.get("minutes_all", meta["minutes"]), nonfinite,
                 abs(zmax["z"]), zmax["method"], zmax["medium"], zmax["sweep"], zmax["value"], fmax["firefly"],
                 fmax["method"], fmax["medium"], fmax["sweep"], fmax["value"]))
     L.append("")
