@@ -3,7 +3,8 @@
  * the ranks); so are a render resumed by 3 ranks from the
  * checkpoint 2 ranks wrote, and a --time render (rank 0 decides the passes) against a single-process
  * render of the spp it reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
- * job with the located message naming that rank, a non-zero status and no image. Skipped (exit 77)
+ * job with the located message naming that rank, a non-zero status and no image; so does a rank given
+ * other options than rank 0. Skipped (exit 77)
  * when murk is built without MPI or mpirun is missing. The ranks run on this machine, oversubscribed
  * (--oversubscribe), as root when need be (OMPI_ALLOW_RUN_AS_ROOT). */
 #include "image.h"
@@ -151,6 +152,18 @@ static void error_on_one_rank_stops_the_job(void **state)
     struct stat st;
     assert_int_not_equal(stat(tmp_path("err.exr"), &st), 0);
     assert_int_not_equal(stat(tmp_path("err.png"), &st), 0);
+    /* a rank given other options than rank 0 (here --spp) is refused the same way */
+    const char *other[] = {getenv("MURK_MPIRUN"), "--oversubscribe",
+                           "-n", "1", getenv("MURK_EXE"), "render", src_path(SCENE), "-o", tmp_path("err.exr"),
+                           "--set", RES, "--spp", "4", "--quiet", ":",
+                           "-n", "1", getenv("MURK_EXE"), "render", src_path(SCENE), "-o", tmp_path("err.exr"),
+                           "--set", RES, "--spp", "5", "--quiet", NULL};
+    rc = run_argv(&log, other);
+    assert_int_not_equal(rc, 0);
+    assert_contains(log, "was given another scene file or other options than rank 0");
+    assert_contains(log, "spp 5");
+    free(log);
+    assert_int_not_equal(stat(tmp_path("err.exr"), &st), 0);
 }
 
 int main(void)
