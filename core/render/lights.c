@@ -117,7 +117,13 @@ static void cross_unit(const double a[3], const double b[3], double out[3])
         out[0] /= l, out[1] /= l, out[2] /= l;
 }
 
-/* Fills r for the rectangle of l seen from p; returns 0 if p is not on its emitting side. */
+static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
+
+/* Closer to a rectangle's plane than this (relative to the coordinates' magnitude, as the integrators'
+ * ray offsets are) a point is taken to be on it: not on the emitting side, sampled by area. */
+#define PLANE_EPS 1e-4f
+
+/* Fills r for the rectangle of l seen from p; returns 0 if p is not clearly on its emitting side. */
 static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
 {
     float lx = murk_length(l->rex), ly = murk_length(l->rey);
@@ -128,7 +134,9 @@ static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
     r->x0 = murk_dot(d, r->ax);
     r->y0 = murk_dot(d, r->ay);
     r->z0 = murk_dot(d, r->az);
-    if (!(r->z0 < 0.0)) /* p behind the emitting side or on the plane */
+    /* p behind the emitting side, or on the plane up to rounding: a point on the light itself (a hit on
+     * its back, rounded to the front) would see the rectangle fill a hemisphere and be lit by it */
+    if (!(r->z0 < -PLANE_EPS * murk_maxf(1.0f, murk_maxf(maxabs(p), maxabs(l->rp0)))))
         return 0;
     r->x1 = r->x0 + lx;
     r->y1 = r->y0 + ly;
