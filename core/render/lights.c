@@ -3,7 +3,9 @@
  * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
  * normal only; spheres emit outwards. With MURK_LIGHT_SOLID_ANGLE (murk/plugin.h) the two triangles of
  * a rectangular quad or box face are sampled together, uniformly in the solid angle of the rectangle
- * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"). */
+ * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
+ * from points that see the rectangle under less than MIN_RECT_OMEGA or lie on its plane up to PLANE_EPS
+ * (a hit on the light itself): those sample it by area, and murk_lights_pdf() follows the same rule. */
 #include "accel.h"
 #include "util.h"
 
