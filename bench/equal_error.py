@@ -6,8 +6,9 @@
                                           [--threads 2] [--scenes cornell,medium,cloud] [--out DIR]
 
 Scenes: `cornell` (scenes/cornell.yaml, path), `medium` (scenes/cornell_smoke.yaml with a constant
-chromatic medium in its box, decomposition tracker, volpath_nee) and `cloud` (cornell_smoke.yaml as it is,
-the procedural cloud, decomposition tracker). Each scene gets a converged reference (sobol, --ref-spp,
+chromatic medium in its box, decomposition tracker, volpath_nee), `cloud` (cornell_smoke.yaml as it is,
+the procedural cloud, decomposition tracker) and, only when asked for (`--scenes ...,lamp`), `lamp`
+(test_boundaries' box scene: a large lamp close above a medium box, for light sampling). Each scene gets a converged reference (sobol, --ref-spp,
 seed 1000; rendered once and kept in DIR). Then `--rounds` rounds, each rendering every configuration
 once in turn (interleaved, so a drift of the machine's speed hits all of them alike) with the round's own
 seed. Error: `murk compare`'s relMSE against the reference, averaged over the rounds (it is an
@@ -33,7 +34,30 @@ SCENES = {
     "cornell": ("cornell.yaml", []),
     "medium": ("cornell_smoke.yaml", MEDIUM),
     "cloud": ("cornell_smoke.yaml", ["--set", "media.smoke.type=decomposition"]),
+    "lamp": ("lamp.yaml", []),  # written into DIR (LAMP)
 }
+# `lamp`: test_boundaries' box scene (tests/test_lights.c): a 1 x 1 lamp just under the ceiling, a
+# constant chromatic medium box right under it (delta tracker, volpath_nee), the lamp large in the
+# solid angle of the box's top and of the walls near it. Written into DIR.
+LAMP = """murk: 1
+render: { resolution: [32, 32], spp: 64, seed: 0 }
+camera: { from: [0, 1, 3.4], at: [0, 1, 0], up: [0, 1, 0], fov: 40 }
+integrator: { type: volpath_nee, max_depth: 1000 }
+materials:
+  white: { type: diffuse, albedo: [0.73, 0.73, 0.73] }
+  red: { type: diffuse, albedo: [0.5, 0.5, 0.5] }
+  green: { type: diffuse, albedo: [0.3, 0.3, 0.3] }
+media:
+  smoke: { type: delta, density: { constant: 1 }, sigma_a: [0.05, 0.1, 0.2], sigma_s: [0.5, 0.5, 0.5] }
+shapes:
+  - { type: quad, center: [0, 0, 0], u: [0, 0, 1], v: [1, 0, 0], material: white }
+  - { type: quad, center: [0, 2, 0], u: [1, 0, 0], v: [0, 0, 1], material: white }
+  - { type: quad, center: [0, 1, -1], u: [1, 0, 0], v: [0, 1, 0], material: white }
+  - { type: quad, center: [-1, 1, 0], u: [0, 1, 0], v: [0, 0, 1], material: red }
+  - { type: quad, center: [1, 1, 0], u: [0, 0, 1], v: [0, 1, 0], material: green }
+  - { type: quad, center: [0, 1.99, 0], u: [0.5, 0, 0], v: [0, 0, 0.5], material: white, emission: [3, 3, 3] }
+  - { type: box, min: [-0.6, 0.1, -0.6], max: [0.6, 1.3, 0.6], interior: smoke }
+"""
 SAMPLERS = ["independent", "sobol"]
 # The media candidates, each alone, as integrator parameters (murk plugins volpath_nee):
 VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=1"],
@@ -77,12 +101,15 @@ def main():
     p.add_argument("--ref-spp", type=int, default=2048)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--threads", type=int, default=2)
-    p.add_argument("--scenes", default=",".join(SCENES))
+    p.add_argument("--scenes", default="cornell,medium,cloud")
     p.add_argument("--variants", default="before,after")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--out", default=os.path.join(ROOT, "bench-out"))
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
+    with open(os.path.join(a.out, "lamp.yaml"), "w") as f:
+        f.write(LAMP)
+    SCENES["lamp"] = (os.path.join(a.out, "lamp.yaml"), [])
     scenes = a.scenes.split(",")
     variants = a.variants.split(",")
     samplers = a.samplers.split(",")

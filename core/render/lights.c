@@ -3,7 +3,9 @@
  * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
  * normal only; spheres emit outwards. With MURK_LIGHT_SOLID_ANGLE (murk/plugin.h) the two triangles of
  * a rectangular quad or box face are sampled together, uniformly in the solid angle of the rectangle
- * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"). */
+ * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
+ * from points that see the rectangle under less than MIN_RECT_OMEGA or lie on its plane up to PLANE_EPS
+ * (a hit on the light itself): those sample it by area, and murk_lights_pdf() follows the same rule. */
 #include "accel.h"
 #include "util.h"
 
@@ -96,28 +98,13 @@ typedef struct srect {
     murk_vec3 ax, ay, az; /* unit frame */
 } srect;
 
-static double angle_between(const double a[3], const double b[3])
-{ /* numerically stable angle between unit vectors */
-    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    if (d < 0.0) {
-        double s[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
-        return M_PI - 2.0 * asin(fmin(1.0, sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / 2.0));
-    }
-    double s[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    return 2.0 * asin(fmin(1.0, sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) / 2.0));
-}
+static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
 
-static void cross_unit(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-    double l = sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
-    if (l > 0.0)
-        out[0] /= l, out[1] /= l, out[2] /= l;
-}
+/* Closer to a rectangle's plane than this (relative to the coordinates' magnitude, as the integrators'
+ * ray offsets are) a point is taken to be on it: not on the emitting side, sampled by area. */
+#define PLANE_EPS 1e-4f
 
-/* Fills r for the rectangle of l seen from p; returns 0 if p is not on its emitting side. */
+/* Fills r for the rectangle of l seen from p; returns 0 if p is not clearly on its emitting side. */
 static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
 {
     float lx = murk_length(l->rex), ly = murk_length(l->rey);
@@ -128,25 +115,22 @@ static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
     r->x0 = murk_dot(d, r->ax);
     r->y0 = murk_dot(d, r->ay);
     r->z0 = murk_dot(d, r->az);
-    if (!(r->z0 < 0.0)) /* p behind the emitting side or on the plane */
+    /* p behind the emitting side, or on the plane up to rounding: a point on the light itself (a hit on
+     * its back, rounded to the front) would see the rectangle fill a hemisphere and be lit by it */
+    if (!(r->z0 < -PLANE_EPS * murk_maxf(1.0f, murk_maxf(maxabs(p), maxabs(l->rp0)))))
         return 0;
     r->x1 = r->x0 + lx;
     r->y1 = r->y0 + ly;
-    double v00[3] = {r->x0, r->y0, r->z0}, v01[3] = {r->x0, r->y1, r->z0};
-    double v10[3] = {r->x1, r->y0, r->z0}, v11[3] = {r->x1, r->y1, r->z0};
-    double n0[3], n1[3], n2[3], n3[3], m0[3], m1[3], m2[3], m3[3];
-    cross_unit(v00, v10, n0);
-    cross_unit(v10, v11, n1);
-    cross_unit(v11, v01, n2);
-    cross_unit(v01, v00, n3);
-    for (int i = 0; i < 3; i++)
-        m0[i] = -n0[i], m1[i] = -n1[i], m2[i] = -n2[i], m3[i] = -n3[i];
-    r->g0 = angle_between(m0, n1);
-    r->g1 = angle_between(m1, n2);
-    r->g2 = angle_between(m2, n3);
-    r->g3 = angle_between(m3, n0);
-    r->n0z = n0[2];
-    r->n2z = n2[2];
+    /* The corner planes' normals in this frame are n0 ~ (0, z0, -y0), n1 ~ (-z0, 0, x1), n2 ~ (0, -z0, y1),
+     * n3 ~ (z0, 0, -x0) (Urena et al.), and the angle between -n_i and n_(i+1) is the atan2 of |z0| |v|
+     * (v the corner they share) over their dot product: g0 at v10, g1 at v11, g2 at v01, g3 at v00. */
+    double x0 = r->x0, y0 = r->y0, x1 = r->x1, y1 = r->y1, z0 = r->z0, az0 = fabs(z0), zz = z0 * z0;
+    r->g0 = atan2(az0 * sqrt(x1 * x1 + y0 * y0 + zz), y0 * x1);
+    r->g1 = atan2(az0 * sqrt(x1 * x1 + y1 * y1 + zz), -x1 * y1);
+    r->g2 = atan2(az0 * sqrt(x0 * x0 + y1 * y1 + zz), x0 * y1);
+    r->g3 = atan2(az0 * sqrt(x0 * x0 + y0 * y0 + zz), -x0 * y0);
+    r->n0z = -y0 / sqrt(y0 * y0 + zz);
+    r->n2z = y1 / sqrt(y1 * y1 + zz);
     r->omega = r->g0 + r->g1 + r->g2 + r->g3 - 2.0 * M_PI;
     return 1;
 }

@@ -9,8 +9,8 @@
  *              light: every emitting triangle uniformly by area, or a rectangular quad or box face
  *              uniformly in the solid angle it subtends (Urena et al. 2013; tiny ones and other shapes
  *              by area). solid_angle is far less noisy for points close to a light, but costs more per
- *              sample, did not lower the error of whole images, and renders one test scene 0.1 %
- *              brighter than area does, unexplained (docs/results.md): experimental.
+ *              sample: at equal time it is at best even with area (docs/results.md), so area is
+ *              the default; both render the same image (tests/test_lights.c).
  *   rr_threshold  float in [0.001, 1], default 1: Russian roulette keeps a path with probability
  *              min(1, weight / rr_threshold) (at least 0.05): 1 plays with every path whose weight fell
  *              below 1, 0.1 only with the paths below a tenth (longer paths, less noise per sample, no
