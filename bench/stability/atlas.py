@@ -104,9 +104,10 @@ def scene_yaml(p, medium, tracker, estimator, res, spp, seed):
         "integrator: { type: volpath_nee, max_depth: 64 }",
         "background: [%g, %g, %g]" % BG,
         "materials:",
-        "  light: { type: diffuse, albedo: [0, 0, 0] }",
-        "  surf: { type: ggx, albedo: [0.1, 0.1, 0.1], specular: [0.9, 0.9, 0.9], roughness: %g }"
-        % (p["roughness"] if p["roughness"] is not None else 0.3),
+        "  light: { type: diffuse, albedo: [0, 0, 0] }"] +
+        # murk render refuses a material no shape uses: surf only with its quad
+        (["  surf: { type: ggx, albedo: [0.1, 0.1, 0.1], specular: [0.9, 0.9, 0.9], roughness: %g }"
+          % p["roughness"]] if p["roughness"] is not None else []) + [
         "media:",
         "  m: { %s }" % ", ".join(keys),
         "shapes:"] + shapes) + "\n"

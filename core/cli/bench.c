@@ -494,19 +494,24 @@ static int bench_render(const bench *b, int v, int bi, int k, const char *const 
 
 /* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
  * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
- * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the scene file's content hash, the
- * --set overrides, the spp and murk's version. */
+ * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the content hash of the scene file and
+ * of every file it loads, the --set overrides, the spp and murk's version. */
 static int make_reference(const bench *b, reference *r)
 {
     char err[2048], dir[3072];
-    uint64_t sh = murk_file_hash(b->scene, err, sizeof err);
-    if (!sh) {
-        fprintf(stderr, "%s\n", err);
-        return -1;
-    }
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
     char *store[64];
     size_t nstore = 0, n = render_sets(b, -1, -1, sets, store, &nstore);
+    /* the scene file and every file it loads (meshes, grids, textures), as a checkpoint hashes them */
+    murk_scene *hs = load_with(b, sets, n, err, sizeof err);
+    uint64_t sh = hs ? murk_scene_hash(hs, err, sizeof err) : 0;
+    murk_scene_free(hs);
+    if (!sh) {
+        fprintf(stderr, "%s\n", err);
+        free_store(store, &nstore);
+        free(sets);
+        return -1;
+    }
     uint64_t h = fnv(1469598103934665603ull, "murk bench reference 1", 23);
     h = fnv(h, MURK_VERSION, sizeof MURK_VERSION);
     h = fnv(h, &sh, sizeof sh);
