@@ -14,6 +14,10 @@
  *   bounds fail    the sinusoid grid with majorant_factor 0.6 (density above the majorant in places) and
  *                  residual_ratio's control 2 (control above the density in places): still unbiased
  *                  (reference: quadrature of the interpolated field); no resolution demanded.
+ *   dense cell     one majorant cell (scale 600, majorant depth 720 / 1860) crossed where the density is
+ *                  1e-4 of its maximum: every estimator against the closed form (issue 9: power_series was
+ *                  0 there, from a float-limited chunk cut and from its order's variance compounding
+ *                  over hundreds of loose chunks). 5e-4 relative slack: ratio tracking's float factors.
  *   variance       on a constant density (majorant exact and 2x loose): unbiased_raymarch has zero
  *                  variance (asserted < 1e-12 T^2: float rounding), residual_ratio too (its control is
  *                  exact); track_length has the largest variance of all (ratio ties with it where the
