@@ -29,9 +29,10 @@
  * product was almost always ~0 (the cloud's lit top 5% dark in the stability atlas). With k0 a chunk's
  * estimate is the full series but for a Poisson tail of 1e-8: bounded variance (that tail, weights ~1, is
  * paid in rare jumps; at 1e-5 the typical estimate of a dense ray's hundreds of chunks was visibly short).
- * A second fault at those depths: a chunk's cut at t ~ 1 that rounded down left a room below half a float
- * step, the next cut could not advance and the rest of the majorant cell ran into that chunk, over the
- * point cap (estimate 0). Such a chunk now counts as full.
+ * A second, rarer fault (found by reading): a chunk's cut that rounded down to a float could leave a room
+ * below half a float step; the next cut could not advance and the rest of the majorant cell ran into that
+ * chunk (ratio-tracked; past 1024 points, stopped at 0). Such a chunk now counts as full, and a ratio-
+ * tracked chunk has no point cap.
  * Cost: per chunk about max(K, k0) lookups (k0 = 20 at tau_bar 4, 68 at 32: the deeper chunks cost
  * fewer lookups per optical depth) plus O(N^2) arithmetic. Russian roulette between chunks (survival =
  * the largest channel, once below 0.1), as ratio tracking. A chunk whose tau_bar exceeds 64 (one float
