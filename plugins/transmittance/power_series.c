@@ -1,8 +1,8 @@
 /* power_series — a cumulative power-series transmittance estimator after Georgiev, Misso, Hachisuka,
  * Nowrouzezahrai, Krivanek, Jarosz 2019 ("Integral formulations of volumetric transmittance"): the
- * majorant as the control, the Poisson distribution of the majorant's optical depth as the order
- * distribution, and every term up to the sampled order evaluated (their cumulative "p-series" family;
- * the single top term alone would be ratio tracking).
+ * majorant as the control, every term up to the order evaluated, the order at least the point where the
+ * Poisson CMF of the majorant's optical depth reaches 1 - 1e-8 and beyond it the Poisson count (their
+ * "p-series CMF"; the single top term alone would be ratio tracking).
  *
  * Parameters
  *   chunk_depth  float in [0.25, 32], default 4. The ray is cut into chunks of about this majorant
@@ -12,18 +12,32 @@
  *
  * Estimator, per chunk with majorant rate mu(t) = dmax(t) x max_c sigma_t,c and optical depth
  * tau_bar = int mu. The points x_1..x_K of a Poisson process of rate mu (K ~ Poisson(tau_bar); given K the
- * points are i.i.d. with density mu / tau_bar) give y_i,c = 1 - sigma_t,c(x_i) / mu(x_i), each unbiased
- * for (tau_bar - tau_c) / tau_bar. With m_k,c the elementary symmetric mean of order k of the y_i,c
- * (unbiased for ((tau_bar - tau_c) / tau_bar)^k given K >= k, and symmetric: the points may come in
- * sorted order) and P(K >= k) the Poisson tail,
- *     T_c = sum_{k=0}^{K} Pois(k; tau_bar) m_k,c / P(K >= k)
+ * points are i.i.d. with density mu / tau_bar), topped up with more i.i.d. points of that density to
+ * N = max(K, k0), k0 the smallest order with P(K <= k0) >= 1 - 1e-8, give y_i,c = 1 - sigma_t,c(x_i) /
+ * mu(x_i), each unbiased for (tau_bar - tau_c) / tau_bar. With m_k,c the elementary symmetric mean of
+ * order k of the y_i,c (unbiased for ((tau_bar - tau_c) / tau_bar)^k given N >= k, and symmetric: the
+ * points may come in sorted order) and P(N >= k) = 1 up to k0, the Poisson tail P(K >= k) above,
+ *     T_c = sum_{k=0}^{N} Pois(k; tau_bar) m_k,c / P(N >= k)
  * has expectation sum_k e^-tau_bar (tau_bar - tau_c)^k / k! = exp(-tau_c): unbiased per channel, for any
  * majorant (where the density exceeds it y < 0 and the terms alternate; the core warns at load). With a
- * tight majorant on constant density (y = 0) T = e^-tau_bar exactly: zero variance. Cost: the same
- * lookups as ratio tracking (one per tentative collision) plus O(K^2) arithmetic per chunk. Russian
- * roulette between chunks (survival = the largest channel, once below 0.1), as ratio tracking. A chunk
- * whose tau_bar exceeds 64 (a float-limited split) falls back to the product of its y (ratio tracking,
- * unbiased); one with more than 1024 points stops with a warning (biased; never seen). */
+ * tight majorant on constant density (y = 0) T = e^-tau_bar exactly: zero variance.
+ *
+ * Why k0 (issue 9): with the order the bare Poisson count (N = K), a chunk where the density is far below
+ * the majorant (y ~ 1, e.g. a shadow ray leaving a dense cloud through the empty part of a dense majorant
+ * cell) gives sum_{k<=K} Pois(k) / P(K >= k), between 0.09 and 1.8 at tau_bar 4, instead of ~1; the
+ * chunks multiply, so the variance grows like exp(c x the loose majorant depth) and at density 1e4 the
+ * product was almost always ~0 (the cloud's lit top 5% dark in the stability atlas). With k0 a chunk's
+ * estimate is the full series but for a Poisson tail of 1e-8: bounded variance (that tail, weights ~1, is
+ * paid in rare jumps; at 1e-5 the typical estimate of a dense ray's hundreds of chunks was visibly short).
+ * A second, rarer fault (found by reading): a chunk's cut that rounded down to a float could leave a room
+ * below half a float step; the next cut could not advance and the rest of the majorant cell ran into that
+ * chunk (ratio-tracked; past 1024 points, stopped at 0). Such a chunk now counts as full, and a ratio-
+ * tracked chunk has no point cap.
+ * Cost: per chunk about max(K, k0) lookups (k0 = 20 at tau_bar 4, 68 at 32: the deeper chunks cost
+ * fewer lookups per optical depth) plus O(N^2) arithmetic. Russian roulette between chunks (survival =
+ * the largest channel, once below 0.1), as ratio tracking. A chunk whose tau_bar exceeds 64 (one float
+ * step of t holding a deep majorant) is ratio-tracked instead (unbiased); one with more than 1024 points
+ * stops with a warning (biased; at tau_bar <= 64 never seen). */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 
@@ -35,6 +49,7 @@ static const murk_param params[P_COUNT] = {
 };
 
 enum { MAX_PIECES = 64, MAX_POINTS = 1024 };
+#define CMF_TAIL 1e-8
 
 typedef struct ps {
     murk_tracker base;
@@ -67,42 +82,66 @@ static double hazard(int k, double tau)
     return 1.0 / s;
 }
 
-/* One chunk's estimate into T (multiplied in). Returns 0 if the point cap was hit. */
+/* y_c = 1 - sigma_t,c(x) / mu at the point t of piece p. */
+static void point_y(const ps *m, const murk_ray *ray, const piece *p, float t, double y[3])
+{
+    float dens = m->base.host->density(m->base.d->density, murk_madd(ray->o, ray->d, t));
+    for (int c = 0; c < 3; c++)
+        y[c] = 1.0 - (double)dens * m->base.sigma_t.c[c] / p->mu;
+}
+
+/* A K-th point's y into the elementary symmetric means mk[0..K] of the K - 1 before it:
+ * e_k(K) = e_k(K-1) + y e_(k-1)(K-1), over C(K, k). */
+static void add_mean(int K, const double y[3], double (*mk)[3])
+{
+    for (int c = 0; c < 3; c++)
+        mk[K][c] = mk[K - 1][c] * y[c];
+    for (int k = K - 1; k >= 1; k--)
+        for (int c = 0; c < 3; c++)
+            mk[k][c] = (mk[k][c] * (K - k) + mk[k - 1][c] * y[c] * k) / K;
+}
+
+/* One chunk's estimate into T (multiplied in). Returns 0 if rouletted or the point cap was hit. A chunk
+ * deeper than 64 (Poisson weights out of double range) is ratio-tracked, with Russian roulette on its
+ * product as murk_ratio_tracking. */
 static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, double tau, murk_rng *rng, double T[3])
 {
-    const murk_host *h = m->base.host;
-    const murk_medium_data *d = m->base.d;
-    double mk[MAX_POINTS + 1][3];
-    int K = 0, ratio = tau > 64.0;
-    double prod[3] = {1.0, 1.0, 1.0};
+    double mk[MAX_POINTS + 1][3], prod[3] = {1.0, 1.0, 1.0}, y[3];
+    int K = 0, k0 = 0, ratio = tau > 64.0;
     mk[0][0] = mk[0][1] = mk[0][2] = 1.0;
-    for (int i = 0; i < n; i++) {
+    /* k0: the order below which the Poisson mass left is under CMF_TAIL (tau <= 64: k0 <= 114) */
+    double pk = exp(-tau), cmf = pk;
+    while (!ratio && cmf < 1.0 - CMF_TAIL && k0 < MAX_POINTS) {
+        k0++;
+        pk *= tau / k0;
+        cmf += pk;
+    }
+    for (int i = 0; i < n; i++) { /* the Poisson process of the majorant: K ~ Poisson(tau) points */
         if (!(pc[i].mu > 0.0f))
             continue;
         for (float t = pc[i].ta;;) {
             t += murk_sample_exp(rng, pc[i].mu);
             if (!(t < pc[i].tb))
                 break;
-            if (K == MAX_POINTS) {
-                h->warn_once("medium '%s': power_series chunk with over %d points: stopped (biased)", d->name,
-                             MAX_POINTS);
+            if (!ratio && K == MAX_POINTS) {
+                m->base.host->warn_once("medium '%s': power_series chunk with over %d points: stopped (biased)",
+                                        m->base.d->name, MAX_POINTS);
                 return 0;
             }
-            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
-            K++;
-            double y[3];
-            for (int c = 0; c < 3; c++) {
-                y[c] = 1.0 - (double)dens * m->base.sigma_t.c[c] / pc[i].mu;
-                prod[c] *= y[c];
-            }
-            if (ratio)
+            point_y(m, ray, &pc[i], t, y);
+            if (!ratio) {
+                add_mean(++K, y, mk);
                 continue;
-            /* elementary symmetric means of y_1..y_K from those of y_1..y_{K-1} */
+            }
             for (int c = 0; c < 3; c++)
-                mk[K][c] = mk[K - 1][c] * y[c];
-            for (int k = K - 1; k >= 1; k--)
+                prod[c] *= y[c];
+            double pm = fmax(fabs(prod[0]), fmax(fabs(prod[1]), fabs(prod[2])));
+            if (pm < 0.1) {
+                if (pm <= 0.0 || murk_rng_float(rng) >= pm)
+                    return 0;
                 for (int c = 0; c < 3; c++)
-                    mk[k][c] = (mk[k][c] * (K - k) + mk[k - 1][c] * y[c] * k) / K;
+                    prod[c] /= pm;
+            }
         }
     }
     if (ratio) {
@@ -110,9 +149,28 @@ static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, doubl
             T[c] *= prod[c];
         return 1;
     }
+    while (K < k0) { /* up to k0 points: more i.i.d. with density mu / tau (a piece by its depth) */
+        double u = murk_rng_float(rng) * tau;
+        int i = 0;
+        for (; i < n - 1; i++) {
+            double di = (double)pc[i].mu * ((double)pc[i].tb - pc[i].ta);
+            if (u < di)
+                break;
+            u -= di;
+        }
+        float t = pc[i].ta + (float)(u / pc[i].mu);
+        if (!(t < pc[i].tb))
+            t = nextafterf(pc[i].tb, pc[i].ta);
+        point_y(m, ray, &pc[i], t, y);
+        add_mean(++K, y, mk);
+    }
+    /* N = max(K, k0) points: P(N >= k) = 1 up to k0, the Poisson tail above */
     double s[3] = {0.0, 0.0, 0.0};
+    pk = exp(-tau);
     for (int k = 0; k <= K; k++) {
-        double w = hazard(k, tau);
+        if (k > 0)
+            pk *= tau / k;
+        double w = k <= k0 ? pk : hazard(k, tau);
         for (int c = 0; c < 3; c++)
             s[c] += w * mk[k][c];
     }
@@ -160,12 +218,22 @@ static murk_rgb ps_estimate(const void *self, const murk_ray *ray, const murk_pa
         if (!isfinite((double)tb - ta))
             return murk_rgb1(0.0f); /* an unbounded medium along an infinite ray */
         float mu = (float)(dmax * smax);
+        if (!(mu > 0.0f))
+            continue;
         while (ta < tb) { /* cut [ta, tb) into pieces that fill chunks of about chunk_depth */
             double room = m->chunk_depth - tau;
             float cut = tb;
             if ((double)mu * ((double)tb - ta) > room) {
                 float tc = (float)(ta + room / mu);
-                if (tc > ta && tc < tb) /* else the whole rest (float-limited): the chunk runs over */
+                if (!(tc > ta)) { /* the room is below half a float step at ta */
+                    if (n > 0) { /* the chunk is full (a cut rounded down by < mu ulp(ta) / 2) */
+                        if (!flush(m, ray, pc, &n, &tau, rng, T))
+                            return murk_rgb1(0.0f);
+                        continue;
+                    }
+                    tc = nextafterf(ta, tb); /* one float step is deeper than a chunk: a chunk of one step */
+                }
+                if (tc < tb)
                     cut = tc;
             }
             pc[n++] = (piece){ta, cut, mu};
