@@ -69,7 +69,7 @@ int murk_box_ok(murk_vec3 lo, murk_vec3 hi)
 {
     for (int a = 0; a < 3; a++) {
         float l = murk_v3_get(lo, a), h = murk_v3_get(hi, a);
-        if (!isfinite(l) || !isfinite(h) || !(l < h) || !isfinite(h - l))
+        if (!isfinite(l) || !isfinite(h) || !(h - l >= MURK_MIN_EXTENT) || !isfinite(h - l))
             return 0;
     }
     return 1;
@@ -133,7 +133,7 @@ float murk_field_eval(const murk_field *f, murk_vec3 p)
     for (int a = 0; a < 3; a++) {
         int n = f->res[a];
         float u = (murk_v3_get(p, a) - murk_v3_get(f->lo, a)) * f->scale[a] - 0.5f;
-        if (u < 0.0f)
+        if (!(u >= 0.0f)) /* NaN too: the cell index below must stay a number */
             u = 0.0f;
         if (u > (float)(n - 1))
             u = (float)(n - 1);

@@ -24,7 +24,10 @@ struct murk_field {
 
 /* Multiplies three positive resolutions; 0 if one is < 1 or the product exceeds MURK_FIELD_MAX_VOXELS. */
 uint64_t murk_voxel_count(int64_t x, int64_t y, int64_t z);
-/* 1 if the box is finite with lo < hi (and a finite extent) on every axis. */
+/* The smallest extent of a grid's box on any axis: cells per unit length (res / extent) must stay a finite
+ * float for every resolution the voxel limit allows. */
+#define MURK_MIN_EXTENT 1e-20f
+/* 1 if the box is finite with hi - lo >= MURK_MIN_EXTENT (and a finite extent) on every axis. */
 int murk_box_ok(murk_vec3 lo, murk_vec3 hi);
 /* A grid field over the finite box [lo, hi] taking ownership of data (freed on failure); NULL when out of
  * memory. The values must already be finite and >= 0. */

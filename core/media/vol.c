@@ -85,7 +85,7 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
     murk_vec3 lo = murk_v3(rd_f32(h + 24), rd_f32(h + 28), rd_f32(h + 32));
     murk_vec3 hi = murk_v3(rd_f32(h + 36), rd_f32(h + 40), rd_f32(h + 44));
     if (!murk_box_ok(lo, hi)) {
-        murk_err_file(err, errlen, path, "bad bounding box (%g %g %g)-(%g %g %g); need finite min < max on every axis", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
+        murk_err_file(err, errlen, path, "bad bounding box (%g %g %g)-(%g %g %g); need finite min < max, at least 1e-20 apart, on every axis", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
         goto fail;
     }
     uint64_t want = n * 4u, have = fsize - VOL_HEADER;
