@@ -29,4 +29,4 @@ static const murk_integrator_vt vt = {sizeof(murk_integrator_vt), MURK_KIND_INTE
                                       murk_pt_li};
 
 MURK_INTEGRATOR_PLUGIN("volpath_nee", "volumetric path tracing, NEE through media + BSDF/phase sampling, MIS",
-                       murk_pt_params, MURK_PT_NPARAMS, &vt)
+                       murk_pt_nee_params, MURK_PT_NEE_NPARAMS, &vt)
