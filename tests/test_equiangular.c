@@ -14,7 +14,9 @@
  *   cloud   cornell_smoke's heterogeneous cloud with chromatic extinction (spectral_mis): the
  *           exponential stand-in for the free-flight pdf is only an approximation there, and the
  *           majorant grid bounds the equiangular range;
- * then bitwise determinism with it on: 1 and 2 threads, one pass and --time's passes. */
+ * then bitwise determinism with it on: 1 and 2 threads, one pass and --time's passes. And the other
+ * switch of this kind, spectral_mis's `closed_form` flights, on the box scene and the lamp in fog
+ * (constant media: closed form all the way), against the tracked flights. */
 #include "testutil.h"
 
 #include <stdio.h>
@@ -48,24 +50,26 @@ static const char *scene(const char *name, const char *header, const char *rest)
 static const char *const OFF[] = {"--set", "integrator.equiangular=false", NULL};
 static const char *const ON[] = {"--set", "integrator.equiangular=true", NULL};
 
-static void agree(const char *label, const char *path, int nseeds)
+static void agree_with(const char *label, const char *path, int nseeds, const char *const *on,
+                       const char *const *off)
 {
     img_stack a, b;
     char out[64];
     snprintf(out, sizeof out, "%s_on.exr", label);
-    img_stack_render(&a, path, out, nseeds, 10, ON);
+    img_stack_render(&a, path, out, nseeds, 10, on);
     snprintf(out, sizeof out, "%s_off.exr", label);
-    img_stack_render(&b, path, out, nseeds, 1000, OFF);
+    img_stack_render(&b, path, out, nseeds, 1000, off);
     int ok = img_stack_agree(label, &a, &b, 4, 4.5);
     img_stack_free(&a);
     img_stack_free(&b);
     assert_true(ok);
 }
 
-static void test_box(void **state)
+static void agree(const char *label, const char *path, int nseeds) { agree_with(label, path, nseeds, ON, OFF); }
+
+static const char *box_scene(void)
 {
-    (void)state;
-    const char *path = scene("box.yaml",
+    return scene("box.yaml",
                              "murk: 1\n"
                              "render: { resolution: [32, 32], spp: 256, seed: 0 }\n"
                              "integrator: { type: volpath_nee, max_depth: 1000 }\n",
@@ -75,13 +79,17 @@ static void test_box(void **state)
                              "media:\n"
                              "  smoke: { type: delta, density: { constant: 1 }, sigma_a: [0.05, 0.1, 0.2], "
                              "sigma_s: [0.5, 0.5, 0.5] }\n");
-    agree("box", path, 8);
 }
 
-static void test_fog(void **state)
+static void test_box(void **state)
 {
     (void)state;
-    const char *path = scene("fog.yaml",
+    agree("box", box_scene(), 8);
+}
+
+static const char *fog_scene(void)
+{
+    return scene("fog.yaml",
                              "murk: 1\n"
                              "render: { resolution: [32, 32], spp: 256, seed: 0 }\n"
                              "integrator: { type: volpath_nee, max_depth: 64 }\n",
@@ -91,7 +99,25 @@ static void test_fog(void **state)
                              "media:\n"
                              "  fog: { type: decomposition, density: { constant: 1 }, sigma_a: 0.02, "
                              "sigma_s: [0.3, 0.25, 0.2], g: 0.3 }\n");
-    agree("fog", path, 8);
+}
+
+static void test_fog(void **state)
+{
+    (void)state;
+    agree("fog", fog_scene(), 8);
+}
+
+static void test_closed_form(void **state)
+{
+    (void)state;
+    static const char *const box_on[] = {"--set", "media.smoke.type=spectral_mis", "--set",
+                                         "media.smoke.closed_form=true", NULL};
+    static const char *const box_off[] = {"--set", "media.smoke.type=spectral_mis", NULL};
+    static const char *const fog_on[] = {"--set", "media.fog.type=spectral_mis", "--set",
+                                         "media.fog.closed_form=true", NULL};
+    static const char *const fog_off[] = {"--set", "media.fog.type=spectral_mis", NULL};
+    agree_with("box closed_form", box_scene(), 8, box_on, box_off);
+    agree_with("fog closed_form", fog_scene(), 8, fog_on, fog_off);
 }
 
 static void test_cloud(void **state)
@@ -154,6 +180,7 @@ int main(void)
         cmocka_unit_test(test_fog),
         cmocka_unit_test(test_cloud),
         cmocka_unit_test(test_bitwise),
+        cmocka_unit_test(test_closed_form),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

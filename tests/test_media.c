@@ -23,7 +23,8 @@
  * The figures are printed: mean +- se (expected, z) per channel.
  *
  * Tests: constant / linear-ramp / sinusoidal grid density x grey / chromatic sigma for every tracker
- * (and spectral's three probability schemes); decomposition control 0, 0.1, 0.5, 1, 2 and majorant
+ * (and spectral's three probability schemes, and spectral_mis's closed_form: in closed form on the
+ * constant grid, tracked on the others); decomposition control 0, 0.1, 0.5, 1, 2 and majorant
  * factor 4 against the closed form and against control 0; majorant factor 0.5 (weighted collisions)
  * for every tracker; Henyey-Greenstein sampling against phase_eval (chi-square). */
 #include "mediatest.h"
@@ -47,6 +48,7 @@ static const mt_spec ALL_TRACKERS[] = {
     {"spectral_max", "type: spectral, probabilities: max", 0},
     {"spectral_avg", "type: spectral, probabilities: average", 0},
     {"spectral_mis", "type: spectral_mis", 0},
+    {"spectral_mis_cf", "type: spectral_mis, closed_form: true", 0},
     {"naive_spectral", "type: naive_spectral", 0},
 };
 #define NTRACKERS ((int)(sizeof ALL_TRACKERS / sizeof ALL_TRACKERS[0]))
@@ -237,6 +239,37 @@ static void test_sinus(void **state)
                       sc.ray, {0}, {0}, sc.D, sc.grid};
         set_sigma(&cfg, chroma);
         check_scene(s, ALL_TRACKERS, &cfg, N_MAIN, NULL);
+        murk_scene_free(s);
+    }
+    assert_int_equal(nfail, 0);
+}
+
+/* A plateau: density 0.8 for z < 0.5, rising to 2.3 at z = 1 (4x4x16 voxels on [0,1]^3). The ramp
+ * case's slanted ray crosses majorant cells of constant density first, then varying ones: spectral_mis's
+ * closed_form takes the first part in closed form and tracks the rest. */
+static float plateau_f(int x, int y, int z, float cx, float cy, float cz)
+{
+    (void)x, (void)y, (void)z, (void)cx, (void)cy;
+    return cz < 0.5f ? 0.8f : 0.8f + 3.0f * (cz - 0.5f);
+}
+
+static void test_plateau(void **state)
+{
+    (void)state;
+    nfail = 0;
+    static const mt_spec ms[] = {
+        {"spectral_mis", "type: spectral_mis", 0},
+        {"spectral_mis_cf", "type: spectral_mis, closed_form: true", 0},
+    };
+    const char *grid = mt_save_grid("plateau.vol", (int[]){4, 4, 16}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), plateau_f);
+    mt_case rc = mt_ramp_case();
+    for (int chroma = 0; chroma < 2; chroma++) {
+        char common[1024];
+        snprintf(common, sizeof common, "density: { grid: %s }, %s", grid, mt_sigma_keys(chroma));
+        murk_scene *s = mt_load_media("plateau.yaml", common, "", ms, 2);
+        config cfg = {chroma ? "plateau, chromatic" : "plateau, grey", rc.ray, {0}, {0}, -1.0, grid};
+        set_sigma(&cfg, chroma);
+        check_scene(s, ms, &cfg, N_MAIN, NULL);
         murk_scene_free(s);
     }
     assert_int_equal(nfail, 0);
@@ -442,6 +475,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_constant),
         cmocka_unit_test(test_ramp),
         cmocka_unit_test(test_sinus),
+        cmocka_unit_test(test_plateau),
         cmocka_unit_test(test_decomposition_control),
         cmocka_unit_test(test_majorant_half),
         cmocka_unit_test(test_hg_phase),
