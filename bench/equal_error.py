@@ -21,7 +21,8 @@ with the spread (min..max) of the per-round ratios. A CSV of every render goes t
 
 "before" switches the media changes of issue 15 off through the integrator's parameters (`light_sampling:
 area`, `rr_threshold: 1`), "after" is the defaults; `--variants before,solid_angle,rr0.1,equiangular,after`
-measures each candidate alone too (`equiangular`: volpath_nee's `equiangular: true`, off by default). The reference renders with the defaults; every
+measures each candidate alone too (`equiangular`: volpath_nee's `equiangular: true`, off by default;
+`smis`: the spectral_mis tracker, `closed_form`: spectral_mis with `closed_form: true`, `cf+eq`: both). The reference renders with the defaults; every
 configuration estimates the same image (tests/test_boundaries.c's z-tests check that)."""
 import argparse, csv, os, re, resource, statistics, subprocess, sys
 
@@ -67,10 +68,15 @@ VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "inte
             "rr0.1": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=0.1"],
             "both": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=0.1"],
             "equiangular": ["--set", "integrator.equiangular=true"],
+            "smis": ["--set", "media.{m}.type=spectral_mis"],
+            "closed_form": ["--set", "media.{m}.type=spectral_mis", "--set", "media.{m}.closed_form=true"],
+            "cf+eq": ["--set", "media.{m}.type=spectral_mis", "--set", "media.{m}.closed_form=true",
+                      "--set", "integrator.equiangular=true"],
             "after": []}
-# Variants that set volpath_nee's own parameters mean nothing to `path` (the cornell scene): there they
-# render as "after".
-NEE_ONLY = {"equiangular"}
+# Variants that set volpath_nee's or a medium's parameters mean nothing to `path` (the cornell scene,
+# no medium): there they render as "after". {m}: the scene's medium.
+NEE_ONLY = {"equiangular", "smis", "closed_form", "cf+eq"}
+MEDIUM_NAME = {"fog": "fog"}  # else "smoke"
 
 
 def run(args):
@@ -130,7 +136,8 @@ def main():
     for rnd in range(a.rounds):
         for (s, smp, v) in configs:
             img = os.path.join(a.out, "ee_%s_%s_%s.exr" % (s, smp, v))
-            extra = [] if (s == "cornell" and v in NEE_ONLY) else VARIANTS[v]
+            extra = [] if (s == "cornell" and v in NEE_ONLY) else \
+                [x.replace("{m}", MEDIUM_NAME.get(s, "smoke")) for x in VARIANTS[v]]
             cpu = render(s, img, a, a.spp, rnd + 1, ["--set", "render.sampler=" + smp] + extra)
             e = relmse(img, refs[s])
             rows.append({"round": rnd, "scene": s, "sampler": smp, "variant": v, "relmse": e, "cpu_s": cpu})
