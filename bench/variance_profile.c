@@ -14,17 +14,20 @@
  * to the sample (murk_pt_tap): surface NEE, medium NEE (at a free-flight vertex), equiangular NEE,
  * emission found by BSDF sampling, by phase sampling, by the camera ray, the background.
  *
- * A term's value per sample is the mean over R, G, B of what it adds to L; a term absent from a sample
- * counts as 0 there. Bounces: the scattering events on the light path the term estimates, its own NEE
- * vertex counted (0: emission seen by the camera ray, 1: direct light at the first vertex = single
- * scattering in a medium, 2: one more bounce, ...), bucketed 0, 1, 2, 3, 4-7, 8+. Per pixel, the sums of
- * each term (each (technique, bounces) cell, each technique over all bounces, each bounce bucket over
+ * A term's value per sample is what it adds to L (R, G and B apart); a term absent from a sample counts as
+ * 0 there. Bounces: the scattering events on the light path the term estimates, its own NEE vertex
+ * counted (0: emission seen by the camera ray, 1: direct light at the first vertex = single scattering
+ * in a medium, 2: one more bounce, ...), bucketed 0, 1, 2, 3, 4-7, 8+. Per pixel and channel, the sums
+ * of each term (each (technique, bounces) cell, each technique over all bounces, each bounce bucket over
  * all techniques) and of its square give its mean and its variance per sample. Printed per term:
- *   mean     the term's mean over the pixels (the sample value's mean is the sum of these);
- *   mean%    its share of the sample's mean, over all pixels;
- *   var%     Var(term) / Var(sample) per pixel, averaged over the pixels whose sample has variance;
- *   relMSE%  its share of the image's relMSE per sample: sum over pixels of Var(term) / (m^2 + 0.01)
- *            over the same sum of Var(sample) (m: the pixel's mean; murk compare's relMSE weights).
+ *   mean     the term's mean over the pixels and channels (the sample's mean is the sum of these);
+ *   mean%    its share of the sample's mean;
+ *   var%     Var(term) / Var(sample) per pixel (variances summed over the channels), averaged over the
+ *            pixels whose sample has variance;
+ *   relMSE%  its share of the image's relMSE per sample: the sum over pixels and channels of Var(term) /
+ *            (m^2 + 0.01) over the same sum of Var(sample) (m: the pixel's channel mean; murk compare's
+ *            relMSE weights, so the relMSE per sample printed at the end is murk compare's relMSE of an
+ *            N-spp image times N, for independent samples).
  * Terms covary (a path that finds light at bounce 1 tends to find it at bounce 2; MIS pairs trade off),
  * so the variance shares of a set of terms do not sum to 100 %: each group's sum is printed with it.
  * Then the paths' ends per bounce count (scattering events done when the path ended): Russian roulette,
@@ -58,19 +61,22 @@ static int bucket(int bounces) { return bounces < 4 ? (bounces < 0 ? 0 : bounces
 
 /* ---- the tap (one thread) -------------------------------------------------------------------------- */
 
-static double cur[NCELL];                    /* this sample's terms */
+static double cur[NCELL][3];                 /* this sample's terms, per channel */
 static int ended;                            /* this sample's path reported its end */
 static uint64_t ends[NB][MURK_PT_NENDS];     /* per bucket: paths ended each way */
+static uint64_t events;                      /* scattering events of the paths that reported their end */
 
 void murk_pt_tap(int depth, int term, murk_rgb value)
 {
     int nee = term == MURK_PT_TERM_SURFACE_NEE || term == MURK_PT_TERM_MEDIUM_NEE || term == MURK_PT_TERM_EQUIANGULAR_NEE;
-    cur[term * NB + bucket(depth + nee)] += ((double)value.c[0] + value.c[1] + value.c[2]) / 3.0;
+    for (int c = 0; c < 3; c++)
+        cur[term * NB + bucket(depth + nee)][c] += value.c[c];
 }
 
 void murk_pt_tap_end(int depth, int why)
 {
     ends[bucket(depth)][why]++;
+    events += (uint64_t)depth;
     ended = 1;
 }
 
@@ -86,23 +92,27 @@ typedef struct profile {
     double seconds;
 } profile;
 
-/* The groups a sample's cells add up to. */
-static void groups(const double *cell, double *g)
+/* The groups a sample's cells add up to, per channel. */
+static void groups(double cell[NCELL][3], double g[NG][3])
 {
     memset(g + G_TECH, 0, (NG - G_TECH) * sizeof *g);
     for (int t = 0; t < MURK_PT_NTERMS; t++)
-        for (int b = 0; b < NB; b++) {
-            double x = cell[t * NB + b];
-            g[t * NB + b] = x;
-            g[G_TECH + t] += x;
-            g[G_BOUNCE + b] += x;
-            g[G_ALL] += x;
-        }
+        for (int b = 0; b < NB; b++)
+            for (int c = 0; c < 3; c++) {
+                double x = cell[t * NB + b][c];
+                g[t * NB + b][c] = x;
+                g[G_TECH + t][c] += x;
+                g[G_BOUNCE + b][c] += x;
+                g[G_ALL][c] += x;
+            }
 }
 
+/* Per pixel and channel c: the mean m_c and the variance per sample V_c of every group. A group's mean
+ * is the mean over channels; its variance share is sum_c V_c(group) / sum_c V_c(sample); its relMSE is
+ * sum_c V_c(group) / (m_c(sample)^2 + 0.01) / 3 (murk compare's relMSE, per sample). */
 static void run(const murk_scene *s, const murk_pt *pt, const int crop[4], int stride, int spp, profile *p)
 {
-    double s1[NG], s2[NG], g[NG];
+    static double s1[NG][3], s2[NG][3], g[NG][3];
     double t0 = murk_now();
     for (int y = crop[1]; y < crop[1] + crop[3]; y += stride)
         for (int x = crop[0]; x < crop[0] + crop[2]; x += stride) {
@@ -124,28 +134,37 @@ static void run(const murk_scene *s, const murk_pt *pt, const int crop[4], int s
                     continue;
                 }
                 groups(cur, g);
-                double l = ((double)L.c[0] + L.c[1] + L.c[2]) / 3.0, abs_sum = 0.0;
-                for (int c = 0; c < NCELL; c++)
-                    abs_sum += fabs(cur[c]);
-                double err = fabs(g[G_ALL] - l) / (fabs(l) + abs_sum + 1e-30);
-                p->max_sum_err = err > p->max_sum_err ? err : p->max_sum_err;
-                for (int i = 0; i < NG; i++) {
-                    s1[i] += g[i];
-                    s2[i] += g[i] * g[i];
+                for (int c = 0; c < 3; c++) {
+                    double abs_sum = 0.0;
+                    for (int i = 0; i < NCELL; i++)
+                        abs_sum += fabs(cur[i][c]);
+                    double err = fabs(g[G_ALL][c] - L.c[c]) / (fabs(L.c[c]) + abs_sum + 1e-30);
+                    p->max_sum_err = err > p->max_sum_err ? err : p->max_sum_err;
                 }
+                for (int i = 0; i < NG; i++)
+                    for (int c = 0; c < 3; c++) {
+                        s1[i][c] += g[i][c];
+                        s2[i][c] += g[i][c] * g[i][c];
+                    }
                 n++;
             }
             if (n < 2)
                 continue;
-            double var[NG];
-            for (int i = 0; i < NG; i++) {
-                double m = s1[i] / n;
-                var[i] = fmax(0.0, (s2[i] - s1[i] * m) / (n - 1));
-                p->mean[i] += m;
+            double var[NG], rel[NG], w[3];
+            for (int c = 0; c < 3; c++) {
+                double m = s1[G_ALL][c] / n;
+                w[c] = 1.0 / (3.0 * (m * m + 0.01));
             }
-            double m = s1[G_ALL] / n, wrel = 1.0 / (m * m + 0.01);
-            for (int i = 0; i < NG; i++)
-                p->rel[i] += var[i] * wrel;
+            for (int i = 0; i < NG; i++) {
+                var[i] = rel[i] = 0.0;
+                for (int c = 0; c < 3; c++) {
+                    double m = s1[i][c] / n, v = fmax(0.0, (s2[i][c] - s1[i][c] * m) / (n - 1));
+                    p->mean[i] += m / 3.0;
+                    var[i] += v;
+                    rel[i] += v * w[c];
+                }
+                p->rel[i] += rel[i];
+            }
             if (var[G_ALL] > 0.0) {
                 for (int i = 0; i < NG; i++)
                     p->share[i] += var[i] / var[G_ALL];
@@ -212,8 +231,10 @@ static void print(const profile *p, const char *path, const murk_scene *s, int s
             for (int e = 0; e < MURK_PT_NENDS; e++)
                 printf("end,%s,%s,%llu\n", bucket_name[b], end_name[e], (unsigned long long)ends[b][e]);
         printf("end,?,other,%llu\n", (unsigned long long)p->ended_untapped);
-        printf("total,pixels,%ld,samples,%llu,relmse_per_sample,%.6g,seconds_per_sample,%.6g,mean,%.6g\n", p->npix,
-               (unsigned long long)p->samples, relmse, p->seconds / (double)p->samples, p->mean[G_ALL] / (double)p->npix);
+        printf("total,pixels,%ld,samples,%llu,relmse_per_sample,%.6g,seconds_per_sample,%.6g,mean,%.6g,"
+               "events_per_path,%.4f\n",
+               p->npix, (unsigned long long)p->samples, relmse, p->seconds / (double)p->samples,
+               p->mean[G_ALL] / (double)p->npix, (double)events / (double)(p->samples - p->ended_untapped + (p->samples == p->ended_untapped)));
         return;
     }
     printf("%s: %s integrator, %ld pixels x %d spp (sampler %s, seed %llu), one thread\n", path,
@@ -228,10 +249,14 @@ static void print(const profile *p, const char *path, const murk_scene *s, int s
     for (int t = 0; t < MURK_PT_NTERMS; t++) {
         if (p->mean[G_TECH + t] == 0.0 && p->rel[G_TECH + t] == 0.0)
             continue;
+        if (fabs(pct(p->mean[G_TECH + t], p->mean[G_ALL])) < 0.005 && pct(p->rel[G_TECH + t], p->rel[G_ALL]) < 0.005)
+            continue;
         const char *tb[NB];
+        char label[64];
         for (int b = 0; b < NB; b++)
             tb[b] = term_name[t];
-        rows(p, t * NB, NB, 1, tb, bucket_name, 0, "sum of shares");
+        snprintf(label, sizeof label, "%s, sum", term_name[t]);
+        rows(p, t * NB, NB, 1, tb, bucket_name, 0, label);
     }
     printf("paths ended, by scattering events done:\n  %-5s", "bnc");
     for (int e = 0; e < MURK_PT_NENDS; e++)
@@ -253,8 +278,9 @@ static void print(const profile *p, const char *path, const murk_scene *s, int s
     printf("  %-5s", "all");
     for (int e = 0; e < MURK_PT_NENDS; e++)
         printf(" %9.2f%%", pct((double)col[e], (double)p->samples));
-    printf("\n  (%llu paths ended elsewhere: a failed or zero BSDF sample, a non-finite value, the watchdog)\n",
-           (unsigned long long)p->ended_untapped);
+    printf("\n  (%llu paths ended elsewhere: a failed or zero BSDF sample, a non-finite value, the watchdog); "
+           "%.3f scattering events per path (the others)\n",
+           (unsigned long long)p->ended_untapped, (double)events / (double)(p->samples - p->ended_untapped + (p->samples == p->ended_untapped)));
     printf("sample mean %.5f, relMSE per sample %.5f (at N spp: about this / N with independent numbers), "
            "%.2f us per sample; %llu samples, %llu non-finite; terms sum to the sample within %.1e (relative)\n",
            p->mean[G_ALL] / (double)p->npix, relmse, 1e6 * p->seconds / (double)p->samples,
