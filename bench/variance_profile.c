@@ -31,8 +31,9 @@
  * Terms covary (a path that finds light at bounce 1 tends to find it at bounce 2; MIS pairs trade off),
  * so the variance shares of a set of terms do not sum to 100 %: each group's sum is printed with it.
  * Then the paths' ends per bounce count (scattering events done when the path ended): Russian roulette,
- * max_depth, absorbed (a free flight's weight 0: a tracker's absorption), escaped (to the background),
- * other (a BSDF sample that failed or weighed 0, a non-finite value). The sample's relMSE per sample
+ * max_depth, absorbed (a free flight's weight 0: a tracker's absorption), escaped (to the background);
+ * the paths that ended otherwise (a BSDF sample that failed or weighed 0, a non-finite value, the
+ * watchdog: no bounce count reported) are counted apart. The sample's relMSE per sample
  * and the seconds per sample (this loop, one thread, the tap included) end the table. --csv prints the
  * same numbers as CSV. Deterministic: a function of the scene (seed included), crop, stride and spp. */
 #include "pathtracer.h"
@@ -54,7 +55,7 @@ enum { G_TECH = NCELL, G_BOUNCE = G_TECH + MURK_PT_NTERMS, G_ALL = G_BOUNCE + NB
 static const char *const term_name[MURK_PT_NTERMS] = {"surface NEE",     "medium NEE",        "equiangular NEE",
                                                       "BSDF emission",   "phase emission",    "camera emission",
                                                       "background"};
-static const char *const end_name[MURK_PT_NENDS] = {"roulette", "max_depth", "absorbed", "escaped", "other"};
+static const char *const end_name[MURK_PT_NENDS] = {"roulette", "max_depth", "absorbed", "escaped"};
 static const char *const bucket_name[NB] = {"0", "1", "2", "3", "4-7", "8+"};
 
 static int bucket(int bounces) { return bounces < 4 ? (bounces < 0 ? 0 : bounces) : bounces < 8 ? 4 : 5; }
@@ -211,10 +212,15 @@ static void rows(const profile *p, int from, int n, int stride, const char *cons
         printf("  %-21s %11s %7.2f %7.2f %8.2f\n", sum_label, "", sm, sv, sr);
 }
 
+/* Mean scattering events of the paths that reported their end. */
+static double events_per_path(const profile *p)
+{
+    uint64_t n = p->samples - p->ended_untapped;
+    return n ? (double)events / (double)n : 0.0;
+}
+
 static void print(const profile *p, const char *path, const murk_scene *s, int spp, int csv)
 {
-    /* a path that ended without a tapped end is an `other` at a bounce count the tap did not see: it is
-     * counted apart */
     double relmse = p->rel[G_ALL] / (double)p->npix;
     if (csv) {
         printf("kind,technique,bounces,mean,mean_share,var_share,relmse_share\n");
@@ -230,11 +236,11 @@ static void print(const profile *p, const char *path, const murk_scene *s, int s
         for (int b = 0; b < NB; b++)
             for (int e = 0; e < MURK_PT_NENDS; e++)
                 printf("end,%s,%s,%llu\n", bucket_name[b], end_name[e], (unsigned long long)ends[b][e]);
-        printf("end,?,other,%llu\n", (unsigned long long)p->ended_untapped);
+        printf("end,,other,%llu\n", (unsigned long long)p->ended_untapped);
         printf("total,pixels,%ld,samples,%llu,relmse_per_sample,%.6g,seconds_per_sample,%.6g,mean,%.6g,"
                "events_per_path,%.4f\n",
                p->npix, (unsigned long long)p->samples, relmse, p->seconds / (double)p->samples,
-               p->mean[G_ALL] / (double)p->npix, (double)events / (double)(p->samples - p->ended_untapped + (p->samples == p->ended_untapped)));
+               p->mean[G_ALL] / (double)p->npix, events_per_path(p));
         return;
     }
     printf("%s: %s integrator, %ld pixels x %d spp (sampler %s, seed %llu), one thread\n", path,
@@ -280,7 +286,7 @@ static void print(const profile *p, const char *path, const murk_scene *s, int s
         printf(" %9.2f%%", pct((double)col[e], (double)p->samples));
     printf("\n  (%llu paths ended elsewhere: a failed or zero BSDF sample, a non-finite value, the watchdog); "
            "%.3f scattering events per path (the others)\n",
-           (unsigned long long)p->ended_untapped, (double)events / (double)(p->samples - p->ended_untapped + (p->samples == p->ended_untapped)));
+           (unsigned long long)p->ended_untapped, events_per_path(p));
     printf("sample mean %.5f, relMSE per sample %.5f (at N spp: about this / N with independent numbers), "
            "%.2f us per sample; %llu samples, %llu non-finite; terms sum to the sample within %.1e (relative)\n",
            p->mean[G_ALL] / (double)p->npix, relmse, 1e6 * p->seconds / (double)p->samples,
