@@ -195,16 +195,30 @@ typedef struct path {
     murk_vec3 prev_p;
     float prev_pdf;
     int prev_delta; /* 1 at the camera and after a delta lobe: no light sample competed */
+    int prev_phase; /* the last scattering vertex was in a medium (for the tap: phase-found emission) */
     int depth, crossings;
     float eta_scale; /* product of eta^2 over transmissions: beta * eta_scale is free of the 1 / eta^2 that
                       * radiance picks up entering a denser medium (for Russian roulette only) */
 } path;
 
-/* L += beta * le * w / mean(R) */
-static void add_light(path *st, murk_rgb le, float w)
+/* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h). */
+static void add_light(path *st, murk_rgb le, float w, int term)
 {
-    st->L = murk_rgb_add(st->L, murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R)));
+    murk_rgb c = murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R));
+    st->L = murk_rgb_add(st->L, c);
+#ifdef MURK_PT_TAP
+    murk_pt_tap(st->depth, term, c);
+#else
+    (void)term;
+#endif
 }
+
+/* How a path ended, for the tap (nothing without it). */
+#ifdef MURK_PT_TAP
+#define PT_TAP_END(st, why) murk_pt_tap_end((st)->depth, (why))
+#else
+#define PT_TAP_END(st, why) ((void)0)
+#endif
 
 /* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side; the
  * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside) or the medium's
@@ -250,10 +264,10 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
                                    const murk_light_sample *ls, murk_rng *rng);
 
 /* Next-event estimation from v with the numbers of slot `slot` (the light choice, then the point),
- * its value times w added to the path: a light point, the transmittance to it, the power heuristic
- * against the vertex's own sampling. */
+ * its value times w added to the path as technique `term`: a light point, the transmittance to it, the
+ * power heuristic against the vertex's own sampling. */
 static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, uint32_t slot,
-                         float w, murk_rng *rng)
+                         float w, int term, murk_rng *rng)
 {
     float u[3];
     murk_sample_seek(rng, slot);
@@ -261,7 +275,7 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
     if (w > 0.0f && pt->host->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
-        add_light(st, light_sample_value(pt, scene, st, v, &ls, rng), w);
+        add_light(st, light_sample_value(pt, scene, st, v, &ls, rng), w, term);
 }
 
 /* f T Le / pdf of the light sample ls at v, weighted by the power heuristic against the vertex's own
@@ -404,7 +418,8 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
     at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
     at.L = murk_rgb1(0.0f);
-    sample_light(pt, scene, &at, &v, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 3), (1.0f - eq_w_ff(sg, t)) / pe, rng);
+    sample_light(pt, scene, &at, &v, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 3), (1.0f - eq_w_ff(sg, t)) / pe,
+                 MURK_PT_TERM_EQUIANGULAR_NEE, rng);
     st->L = murk_rgb_add(st->L, at.L);
 }
 
@@ -430,17 +445,18 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     st->beta = murk_rgb_mul(st->beta, ev.weight);
     st->R = murk_rgb_mul(st->R, ev.pdf_ratio);
     if (murk_rgb_is_black(st->beta) || !(mean3(st->R) > 0.0f))
-        return PT_END;
+        return PT_TAP_END(st, MURK_PT_END_ABSORBED), PT_END;
     if (!ev.scattered)
         return PT_PASSED;
     if (st->depth >= pt->max_depth)
-        return PT_END;
+        return PT_TAP_END(st, MURK_PT_END_MAX_DEPTH), PT_END;
     vertex v = {0};
     v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
     v.wo = murk_neg(st->ray.d);
     v.g = m->data->g;
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
-        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t), rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t),
+                     MURK_PT_TERM_MEDIUM_NEE, rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
@@ -451,6 +467,7 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     st->prev_p = v.p;
     st->prev_pdf = pdf;
     st->prev_delta = 0;
+    st->prev_phase = 1;
     st->ray = ray_from(v.p, wi);
     st->depth++;
     return PT_SCATTERED;
@@ -465,9 +482,11 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     murk_rgb le = murk_hit_le(hit, wo);
     if (!murk_rgb_is_black(le))
         add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy))
-                                                     : 1.0f);
+                                                     : 1.0f,
+                  st->depth == 0 ? MURK_PT_TERM_CAMERA_EMISSION : st->prev_phase ? MURK_PT_TERM_PHASE_EMISSION
+                                                                                 : MURK_PT_TERM_BSDF_EMISSION);
     if (st->depth >= pt->max_depth)
-        return 0;
+        return PT_TAP_END(st, MURK_PT_END_MAX_DEPTH), 0;
     vertex v = {0};
     v.p = hit->p;
     v.wo = wo;
@@ -487,7 +506,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
         v.wo_local.z = 1e-6f;
     if (pt->nee)
-        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), 1.0f, rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), 1.0f, MURK_PT_TERM_SURFACE_NEE, rng);
     float u[3];
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
@@ -513,6 +532,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     st->prev_p = hit->p;
     st->prev_pdf = bs.pdf;
     st->prev_delta = bs.delta;
+    st->prev_phase = 0;
     st->ray = ray_from(offset(hit->p, v.offset_n, wi), wi);
     st->depth++;
     return 1;
@@ -544,7 +564,7 @@ static int roulette(const murk_pt *pt, path *st, murk_rng *rng)
         q = murk_maxf(0.05f, murk_minf(1.0f, q));
         murk_sample_seek(rng, PT_SLOT(st->depth - 1, PT_SLOT_ROULETTE)); /* depth was counted up at the vertex */
         if (murk_sample_1d(rng) >= q)
-            return 0;
+            return PT_TAP_END(st, MURK_PT_END_ROULETTE), 0;
         st->beta = murk_rgb_scale(st->beta, 1.0f / q);
     }
     return !murk_rgb_is_black(st->beta);
@@ -582,7 +602,8 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
             }
         }
         if (!found) {
-            add_light(&st, h->background(scene, st.ray.d), 1.0f);
+            add_light(&st, h->background(scene, st.ray.d), 1.0f, MURK_PT_TERM_BACKGROUND);
+            PT_TAP_END(&st, MURK_PT_END_ESCAPED);
             break;
         }
         if (!hit.material) {
