@@ -1,8 +1,6 @@
 /* lights.c — emissive shapes as lights: one light per emitting triangle or sphere, chosen in
- * proportion to its power (luminance x area), sampled uniformly by area (triangles; either triangle of
- * a rectangular quad or box face maps its two numbers onto the whole rectangle, which has the same
- * density and keeps a stratified 2-D slot stratified on the light) or uniformly in the cone of
- * directions the sphere subtends (spheres). Triangles and quads emit on the side of their
+ * proportion to its power (luminance x area), sampled uniformly by area (triangles) or uniformly in
+ * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
  * normal only; spheres emit outwards. With MURK_LIGHT_SOLID_ANGLE (murk/plugin.h) the two triangles of
  * a rectangular quad or box face are sampled together, uniformly in the solid angle of the rectangle
  * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
@@ -224,14 +222,8 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
         ls->pdf = (float)(l->rect_pmf / r.omega);
         return isfinite(ls->pdf) && ls->pdf > 0.0f;
     }
-    murk_vec3 q;
-    if (l->rect) { /* the whole rectangle from u[1], u[2]: the same density (its halves have one pmf per
-                    * area), and the slot's stratification lands on it undistorted */
-        q = murk_add(l->rp0, murk_add(murk_mul(l->rex, u[1]), murk_mul(l->rey, u[2])));
-    } else {
-        float su = sqrtf(u[1]);
-        q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
-    }
+    float su = sqrtf(u[1]);
+    murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
     murk_vec3 d = murk_sub(q, p);
     float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
     if (dist <= 0.0f)
