@@ -95,6 +95,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin, cscale = 1.0f, boost = 1.0f;
+    int first = murk_flight_stratified(d); /* the flight's first number from the sampler (murk/tracking.h) */
     long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         if (++steps > MURK_WATCHDOG_ITERATIONS) {
@@ -106,14 +107,14 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
         decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
-        float tc = rate_c > 0.0f ? murk_advance(ta, murk_sample_exp(rng, rate_c)) : INFINITY;
+        float tc = rate_c > 0.0f ? murk_advance(ta, murk_flight_exp(rng, &first, rate_c)) : INFINITY;
         for (float t = ta;;) {
             if (++steps > MURK_WATCHDOG_ITERATIONS) {
                 murk_tracker_watchdog(&m->base, "a free flight");
                 murk_event_kill(ev, t);
                 return;
             }
-            float tr = mu_r > 0.0f ? murk_advance(t, murk_sample_exp(rng, mu_r)) : INFINITY;
+            float tr = mu_r > 0.0f ? murk_advance(t, murk_flight_exp(rng, &first, mu_r)) : INFINITY;
             if (!(tc < tb) && !(tr < tb))
                 break;
             count->collisions++; /* a control or a residual collision */

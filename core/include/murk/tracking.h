@@ -81,6 +81,34 @@ static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb
 /* Distance to the next event of a Poisson process of rate mu > 0. */
 static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-murk_rng_float(rng)) / mu; }
 
+/* Stratified free flights (the medium's `stratify_flights` key, murk_medium_data.stratify_flights). The
+ * integrator seeks (murk_sample_seek) to a slot of the flight's own before sample(); a stratified flight
+ * takes its FIRST random number from that slot (murk_sample_1d: with render.sampler sobol, stratified over
+ * the pixel's samples) and every later one from the PCG stream, so the collision loop's unbounded use
+ * never moves the integrator's slots. It changes which numbers a flight uses, never its method or its
+ * distribution. With render.sampler independent murk_sample_1d is murk_rng_float in call order: the
+ * numbers are those of an unstratified flight. A tracker keeps `int first = murk_flight_stratified(d)`
+ * per flight and draws with murk_flight_float / murk_flight_exp (murk_collisions does this itself). */
+static inline int murk_flight_stratified(const murk_medium_data *d)
+{
+    return MURK_HAS(d->size, murk_medium_data, stratify_flights) && d->stratify_flights;
+}
+
+/* A uniform number in [0, 1): the sampler's slot if *first (which it clears), else the PCG stream. */
+static inline float murk_flight_float(murk_rng *rng, int *first)
+{
+    if (!*first)
+        return murk_rng_float(rng);
+    *first = 0;
+    return murk_sample_1d(rng);
+}
+
+/* murk_sample_exp with murk_flight_float's number. */
+static inline float murk_flight_exp(murk_rng *rng, int *first, float mu)
+{
+    return -log1pf(-murk_flight_float(rng, first)) / mu;
+}
+
 /* t + step, but at least the next float above t: a loop that steps t always advances (the watchdog
  * contract, murk/plugin.h), even where a step is below the float spacing of t. */
 static inline float murk_advance(float t, float step)
@@ -178,6 +206,7 @@ typedef struct murk_collisions {
     float boost; /* this flight's majorant multiplier, raised where the majorant failed */
     long steps;  /* collisions and cells so far */
     int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
+    int first;   /* 1 until the flight's first number is drawn, if the flight is stratified */
     murk_counters *count, scratch; /* the medium's cost counters (murk_tracker_counters) */
 } murk_collisions;
 
@@ -192,6 +221,7 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->boost = 1.0f;
     c->steps = 0;
     c->stopped = 0;
+    c->first = murk_flight_stratified(tr->d);
     c->count = murk_tracker_counters(tr->host, tr->d, &c->scratch);
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
 }
@@ -221,7 +251,7 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
             return 0;
         }
         if (c->mu > 0.0f) {
-            c->t = murk_advance(c->t, murk_sample_exp(rng, c->mu));
+            c->t = murk_advance(c->t, murk_flight_exp(rng, &c->first, c->mu));
             if (c->t < c->tb) {
                 c->count->collisions++;
                 *t = c->t;
