@@ -20,12 +20,14 @@ with the spread (min..max) of the per-round ratios. A CSV of every render goes t
 
 "before" switches the media changes of issue 15 off through the integrator's parameters (`light_sampling:
 area`, `rr_threshold: 1`), "after" is the defaults; `--variants before,solid_angle,rr0.1,after` measures
-each candidate alone too. The reference renders with the defaults; every
+each candidate alone too; `noflight` is "after" with the medium's stratified free flights off
+(`stratify_flights: false`: every number of a flight from the PCG stream), e.g.
+`--scenes cloud,cloud_delta,medium,medium_delta,grey --samplers sobol --variants noflight,after`. The reference renders with the defaults; every
 configuration estimates the same image (tests/test_boundaries.c's z-tests check that)."""
 import argparse, csv, os, re, resource, statistics, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MURK = os.path.join(ROOT, "build", "core", "murk")
+MURK = os.environ.get("MURK", os.path.join(ROOT, "build", "core", "murk"))  # MURK=path: another build
 
 MEDIUM = ["--set", "media.smoke.type=decomposition", "--set", "media.smoke.density={constant: 1}",
           "--set", "media.smoke.sigma_a=[0.05, 0.1, 0.3]", "--set", "media.smoke.sigma_s=[1.2, 0.8, 0.4]",
@@ -34,6 +36,13 @@ SCENES = {
     "cornell": ("cornell.yaml", []),
     "medium": ("cornell_smoke.yaml", MEDIUM),
     "cloud": ("cornell_smoke.yaml", ["--set", "media.smoke.type=decomposition"]),
+    # only when asked for (--scenes ...): the same media with delta tracking, and a homogeneous grey medium
+    # (delta: there the first tentative collision of a flight is its scattering distance)
+    "cloud_delta": ("cornell_smoke.yaml", ["--set", "media.smoke.type=delta"]),
+    "medium_delta": ("cornell_smoke.yaml", MEDIUM + ["--set", "media.smoke.type=delta"]),
+    "grey": ("cornell_smoke.yaml", ["--set", "media.smoke.type=delta", "--set", "media.smoke.density={constant: 1}",
+                                    "--set", "media.smoke.sigma_a=[0.1, 0.1, 0.1]",
+                                    "--set", "media.smoke.sigma_s=[0.9, 0.9, 0.9]", "--set", "media.smoke.g=0.2"]),
     "lamp": ("lamp.yaml", []),  # written into DIR (LAMP)
 }
 # `lamp`: test_boundaries' box scene (tests/test_lights.c): a 1 x 1 lamp just under the ceiling, a
@@ -64,7 +73,9 @@ VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "inte
             "solid_angle": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=1"],
             "rr0.1": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=0.1"],
             "both": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=0.1"],
-            "after": []}
+            "after": [],
+            # stratified free flights (the medium key stratify_flights, default on) switched off alone
+            "noflight": ["--set", "media.smoke.stratify_flights=false"]}
 
 
 def run(args):
