@@ -4,6 +4,8 @@
 
     /usr/bin/python3 bench/equal_error.py [--res 64] [--spp 64] [--ref-spp 2048] [--rounds 3]
                                           [--threads 2] [--scenes cornell,medium,cloud] [--out DIR]
+                                          [--samplers independent,sobol] [--variants before,after] [--crop X,Y,W,H]
+                                          [--seed0 1]
 
 Scenes: `cornell` (scenes/cornell.yaml, path), `medium` (scenes/cornell_smoke.yaml with a constant
 chromatic medium in its box, decomposition tracker, volpath_nee), `cloud` (cornell_smoke.yaml as it is,
@@ -97,8 +99,8 @@ def render(scene, out, a, spp, seed, extra):
     return run(args)[1]
 
 
-def relmse(img, ref):
-    out, _ = run(["compare", img, ref])
+def relmse(img, ref, crop=None):
+    out, _ = run(["compare", img, ref] + (["--crop", crop] if crop else []))
     m = re.search(r"relMSE ([0-9.eE+-]+)", out)
     if not m:
         sys.exit("murk compare: no relMSE in:\n" + out)
@@ -116,6 +118,8 @@ def main():
     p.add_argument("--variants", default="before,after")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--out", default=os.path.join(ROOT, "bench-out"))
+    p.add_argument("--seed0", type=int, default=1, help="round r renders with seed SEED0 + r")
+    p.add_argument("--crop", help="X,Y,W,H: the relMSE of that rectangle only (murk compare --crop)")
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "lamp.yaml"), "w") as f:
@@ -135,8 +139,8 @@ def main():
     for rnd in range(a.rounds):
         for (s, smp, v) in configs:
             img = os.path.join(a.out, "ee_%s_%s_%s.exr" % (s, smp, v))
-            cpu = render(s, img, a, a.spp, rnd + 1, ["--set", "render.sampler=" + smp] + VARIANTS[v])
-            e = relmse(img, refs[s])
+            cpu = render(s, img, a, a.spp, a.seed0 + rnd, ["--set", "render.sampler=" + smp] + VARIANTS[v])
+            e = relmse(img, refs[s], a.crop)
             rows.append({"round": rnd, "scene": s, "sampler": smp, "variant": v, "relmse": e, "cpu_s": cpu})
             print("round %d  %-8s %-12s %-7s relMSE %.4e  cpu %7.2f s" % (rnd, s, smp, v, e, cpu), flush=True)
     with open(os.path.join(a.out, "equal_error.csv"), "w", newline="") as f:

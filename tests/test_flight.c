@@ -42,7 +42,7 @@ static int flights_stratified(const murk_medium *m, uint64_t seed, uint64_t pixe
     int n = 1 << k, ok = 1;
     double *u = malloc((size_t)n * sizeof *u);
     assert_non_null(u);
-    murk_ray ray = {{0, 0, 0}, {0, 0, 1}, 0.0f, INFINITY};
+    murk_ray ray = {{0.5f, 0.5f, 0}, {0, 0, 1}, 0.0f, INFINITY};
     murk_path_ctx ctx = {0, {{1, 1, 1}}};
     for (int i = 0; i < n; i++) {
         murk_rng r;
@@ -60,33 +60,55 @@ static int flights_stratified(const murk_medium *m, uint64_t seed, uint64_t pixe
     return ok;
 }
 
-static void test_stratified(void **state)
+static float one_f(int x, int y, int z, float cx, float cy, float cz)
 {
-    (void)state;
+    (void)x, (void)y, (void)z, (void)cx, (void)cy, (void)cz;
+    return 1.0f;
+}
+
+/* `common`: density 1 everywhere the flights go (the first tentative collision is real) for the ntr
+ * trackers and a last medium, delta with the key off; mu is the extinction. */
+static void check_stratified(const char *what, const char *common, const char *const *trackers, int ntr, float mu)
+{
     mt_spec ms[NTRACKERS + 1];
     char keys[NTRACKERS + 1][64];
-    for (int i = 0; i < NTRACKERS; i++) {
-        snprintf(keys[i], sizeof keys[i], "type: %s", TRACKERS[i]);
-        ms[i] = (mt_spec){TRACKERS[i], keys[i], 0};
+    for (int i = 0; i < ntr; i++) {
+        snprintf(keys[i], sizeof keys[i], "type: %s", trackers[i]);
+        ms[i] = (mt_spec){trackers[i], keys[i], 0};
     }
-    ms[NTRACKERS] = (mt_spec){"delta_off", "type: delta, stratify_flights: false", 0};
-    murk_scene *s = mt_load_media("strat.yaml", "density: { constant: 1 }, " MT_GREY_KEYS, "", ms, NTRACKERS + 1);
-    const float mu = 1.2f; /* density 1 x sigma_t: delta's majorant, decomposition's control rate */
+    ms[ntr] = (mt_spec){"delta_off", "type: delta, stratify_flights: false", 0};
+    murk_scene *s = mt_load_media("strat.yaml", common, "", ms, ntr + 1);
     static const uint32_t slots[] = {0x20000000u, 0x20000000u + 3u * 1024u + 1u, 7u};
-    for (int i = 0; i <= NTRACKERS; i++) {
+    for (int i = 0; i <= ntr; i++) {
         int all = 1;
         for (int k = 2; k <= 8; k += 2)
             for (uint64_t pixel = 0; pixel < 3; pixel++)
                 for (size_t sl = 0; sl < sizeof slots / sizeof slots[0]; sl++)
                     all &= flights_stratified(&s->media[i].m, 5u + pixel, pixel * 977u, slots[sl], k, mu);
-        printf("%-15s first collisions one per interval of 2^-k, k = 2..8, 3 pixels x 3 slots: %s\n", ms[i].label,
-               all ? "yes" : "no");
-        if (i < NTRACKERS)
+        printf("%s, %-15s first collisions one per interval of 2^-k, k = 2..8, 3 pixels x 3 slots: %s\n", what,
+               ms[i].label, all ? "yes" : "no");
+        if (i < ntr)
             assert_true(all);
         else
             assert_false(all); /* stratify_flights: false draws from PCG */
     }
     murk_scene_free(s);
+}
+
+static void test_stratified(void **state)
+{
+    (void)state;
+    /* one majorant segment: density 1 x sigma_t is delta's majorant and decomposition's control rate */
+    check_stratified("constant", "density: { constant: 1 }, " MT_GREY_KEYS, TRACKERS, NTRACKERS, 1.2f);
+    /* a grid of 1s: the flight crosses majorant cells before its first collision (mean 1/24 of the box,
+     * 16 cells across), and the stratified optical depth carries over them (murk_collisions; not
+     * decomposition, whose stratified number is its first cell's) */
+    const int res[3] = {4, 4, 4};
+    char common[512];
+    snprintf(common, sizeof common, "density: { grid: '%s' }, majorant_resolution: 16, scale: 20, %s",
+             mt_save_grid("ones.vol", res, murk_v3(0, 0, 0), murk_v3(1, 1, 1), one_f), MT_GREY_KEYS);
+    static const char *const grid_trackers[] = {"delta", "spectral", "spectral_mis", "naive_spectral"};
+    check_stratified("16 cells", common, grid_trackers, 4, 24.0f);
 }
 
 /* A flight with many null collisions (checker grid 0.2 / 1.4, majorant x 4) takes one slot if the key

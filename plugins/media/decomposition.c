@@ -13,6 +13,10 @@
  *            is tracked with the control lowered below the density seen (murk/tracking.h's per-flight
  *            repair; noisier than the clamp) and murk says so once.
  *
+ * The medium's common keys are read by the core. With stratify_flights (murk/tracking.h) the flight's
+ * first draw takes the sampler slot's number: the control distance of the first cell with a control,
+ * else that cell's first residual distance (it is not carried over cells as murk_collisions' is).
+ *
  * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
  * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
  * mu_r = max density x max_c sigma_t - c sigma_min. The first of a control event (real in every channel)

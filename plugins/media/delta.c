@@ -1,7 +1,9 @@
 /* delta — delta (Woodcock) tracking for free flights, residual ratio tracking for transmittance.
  *
  * Parameters: none of its own. The medium's common keys (density, sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution) are read by the core.
+ * majorant_factor, majorant_resolution, majorant_repair, stratify_flights) are read by the core; with
+ * stratify_flights the first tentative collision's optical depth comes from the flight's sampler slot
+ * (murk_collisions, murk/tracking.h), as in spectral, spectral_mis and naive_spectral.
  *
  * Tentative collisions are drawn with the majorant mu = max density of the grid cell x max channel of
  * sigma_t, cell by cell along the ray. A tentative collision at x is real with probability

@@ -197,7 +197,13 @@ static inline void murk_warn_majorant(const murk_tracker *t, const char *what)
 
 /* Tentative collisions along a ray: a Poisson process whose rate in each majorant cell is
  * mu = (the cell's maximum density) x sigma x boost, walked cell by cell (delta tracking's proposal);
- * boost starts at 1 and only murk_collisions_raise changes it. */
+ * boost starts at 1 and only murk_collisions_raise changes it. A stratified flight (murk_flight_stratified)
+ * with render.sampler sobol draws its first tentative collision's majorant optical depth tau = -ln(1 - u)
+ * once, from the slot, and carries what is left of it over the cells it passes (tau - mu x the cell's
+ * length; exponential distances are memoryless, so this is the same process as a fresh draw per cell),
+ * so the slot's stratification reaches the first collision wherever it lies; later collisions draw
+ * afresh from the PCG stream in each cell. With independent numbers each cell draws afresh, as before
+ * the key existed (the same numbers in the same order). */
 typedef struct murk_collisions {
     const murk_tracker *tr;
     const murk_ray *ray;
@@ -207,6 +213,7 @@ typedef struct murk_collisions {
     long steps;  /* collisions and cells so far */
     int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
     int first;   /* 1 until the flight's first number is drawn, if the flight is stratified */
+    float tau;   /* the stratified first draw's optical depth still to go (carried over cells), < 0: none */
     murk_counters *count, scratch; /* the medium's cost counters (murk_tracker_counters) */
 } murk_collisions;
 
@@ -222,6 +229,7 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->steps = 0;
     c->stopped = 0;
     c->first = murk_flight_stratified(tr->d);
+    c->tau = -1.0f;
     c->count = murk_tracker_counters(tr->host, tr->d, &c->scratch);
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
 }
@@ -251,7 +259,16 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
             return 0;
         }
         if (c->mu > 0.0f) {
-            c->t = murk_advance(c->t, murk_flight_exp(rng, &c->first, c->mu));
+            float t0 = c->t, tau;
+            int carry = c->tau >= 0.0f;
+            if (carry) {
+                tau = c->tau;
+            } else {
+                carry = c->first && rng->sampler == MURK_SAMPLER_SOBOL;
+                tau = -log1pf(-murk_flight_float(rng, &c->first));
+            }
+            c->t = murk_advance(c->t, tau / c->mu);
+            c->tau = carry && !(c->t < c->tb) ? fmaxf(0.0f, tau - c->mu * (c->tb - t0)) : -1.0f;
             if (c->t < c->tb) {
                 c->count->collisions++;
                 *t = c->t;
