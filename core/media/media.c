@@ -14,7 +14,7 @@
  *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (repaired, warned)
  *       majorant_resolution: 16     # majorant grid cells along the field's longest axis
  *       majorant_repair: true       # cells a factor < 1 left below the density get their exact bound back
- *       stratify_flights: true      # a free flight's first number from the sampler (murk/tracking.h)
+ *       stratify_flights: true      # a free flight's first numbers from the sampler (murk/tracking.h)
  *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
  *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
@@ -242,8 +242,8 @@ MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
                            "raise majorant cells that majorant_factor < 1 left below the density to their exact bound "
                            "before rendering; false: trackers repair per flight (unbiased, noisier)"},
     [K_STRATIFY_FLIGHTS] = {"stratify_flights", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
-                            "a free flight's first random number from the sampler (stratified over a pixel's "
-                            "samples with render.sampler: sobol); false: all from the PCG stream"},
+                            "a free flight's first distance and collision choice from the sampler (stratified over "
+                            "a pixel's samples with render.sampler: sobol); false: all from the PCG stream"},
 };
 MURK_API const char *const murk_medium_special_keys[2] = {"density", "transmittance"};
 

@@ -50,7 +50,7 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
         }
         if (amax > 1.0f)
             murk_warn_majorant(m, "spectral MIS weights");
-        if (murk_rng_float(rng) < q[hero]) {
+        if (murk_collisions_choice(&c, rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
                 ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
                 ev->pdf_ratio.c[k] *= q[k] / q[hero];

@@ -61,10 +61,11 @@ typedef struct murk_medium_data {
     const char *name;             /* the medium's name in the scene, for messages */
     /* Appended after ABI 1.4's fields (read it only if MURK_HAS(size, murk_medium_data, stratify_flights)):
      * the medium's `stratify_flights` key. 1: the integrator has sought (murk_sample_seek) to this flight's
-     * own sampler slot before sample(), and the tracker takes the FIRST random number of the flight with
-     * murk_sample_1d(rng) (stratified over a pixel's samples with render.sampler: sobol), every later one
-     * with murk_rng_float(rng). 0: every number from murk_rng_float, as trackers built before it do.
-     * murk/tracking.h's murk_collisions and murk_flight_first() read it. */
+     * own sampler slot before sample(), and the tracker takes the flight's FIRST random numbers from it
+     * (with render.sampler sobol a 2-D point stratified over a pixel's samples: the first distance and
+     * the first collision's choice), every later one with murk_rng_float(rng). 0: every number from
+     * murk_rng_float, as trackers built before it do. murk/tracking.h's murk_flight_* helpers and
+     * murk_collisions do this. */
     int stratify_flights;
 } murk_medium_data;
 
