@@ -5,6 +5,8 @@
  *   stratified   every tracker, a grey constant medium (the first tentative collision is the
  *                scattering event): over a pixel's first 2^k samples the first collisions' uniforms
  *                1 - exp(-mu t) fall one per interval [j/2^k, (j+1)/2^k); with the key off they do not
+ *   helpers      murk_flight_float + murk_flight_choice: with sobol the slot's 2-D point (a (0, 6, 2)-net
+ *                over 64 samples), later numbers from PCG; with independent numbers PCG's in call order
  *   one slot     a flight with many null collisions (checker grid, majorant x 4) takes exactly one slot
  *                (none with the key off): the collision loop never moves the integrator's slots
  *   same image   every tracker with the key on renders the expected image of the key off, on
@@ -109,6 +111,42 @@ static void test_stratified(void **state)
              mt_save_grid("ones.vol", res, murk_v3(0, 0, 0), murk_v3(1, 1, 1), one_f), MT_GREY_KEYS);
     static const char *const grid_trackers[] = {"delta", "spectral", "spectral_mis", "naive_spectral"};
     check_stratified("16 cells", common, grid_trackers, 4, 24.0f);
+}
+
+/* The helpers' pair (murk_flight_float's first number, murk_flight_choice's): with sobol the slot's 2-D
+ * point — over a pixel's first 2^k samples one in each elementary interval 2^-a x 2^-(k-a) — and the
+ * choice after it from PCG; with independent numbers both from the PCG stream in call order. */
+static void test_helpers(void **state)
+{
+    (void)state;
+    enum { K = 6, N = 1 << K };
+    float u[N][2];
+    for (int i = 0; i < N; i++) {
+        murk_rng r, pcg;
+        murk_sampler_start(&r, MURK_SAMPLER_SOBOL, 9, 4242, (uint32_t)i);
+        murk_sample_seek(&r, 0x20000000u);
+        pcg = r;
+        int first = 1;
+        float uc = -1.0f;
+        u[i][0] = murk_flight_float(&r, &first, &uc);
+        u[i][1] = murk_flight_choice(&r, &uc);
+        assert_int_equal(first, 0);
+        assert_true(murk_flight_choice(&r, &uc) == murk_rng_float(&pcg)); /* later choices: PCG */
+        assert_true(murk_flight_float(&r, &first, &uc) == murk_rng_float(&pcg));
+        murk_sampler_start(&r, MURK_SAMPLER_INDEPENDENT, 9, 4242, (uint32_t)i);
+        pcg = r;
+        first = 1;
+        uc = -1.0f;
+        assert_true(murk_flight_float(&r, &first, &uc) == murk_rng_float(&pcg));
+        assert_true(murk_flight_choice(&r, &uc) == murk_rng_float(&pcg));
+    }
+    for (int a = 0; a <= K; a++) {
+        unsigned char seen[N] = {0};
+        for (int i = 0; i < N; i++) {
+            int cell = ((int)(u[i][0] * (float)(1 << a)) << (K - a)) | (int)(u[i][1] * (float)(1 << (K - a)));
+            assert_int_equal(seen[cell]++, 0);
+        }
+    }
 }
 
 /* A flight with many null collisions (checker grid 0.2 / 1.4, majorant x 4) takes one slot if the key
@@ -248,7 +286,8 @@ static void test_key(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_stratified), cmocka_unit_test(test_one_slot), cmocka_unit_test(test_key),
+        cmocka_unit_test(test_stratified), cmocka_unit_test(test_helpers), cmocka_unit_test(test_one_slot),
+        cmocka_unit_test(test_key),
         cmocka_unit_test(test_bitwise),    cmocka_unit_test(test_same_image),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
