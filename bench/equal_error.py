@@ -4,6 +4,8 @@
 
     /usr/bin/python3 bench/equal_error.py [--res 64] [--spp 64] [--ref-spp 2048] [--rounds 3]
                                           [--threads 2] [--scenes cornell,medium,cloud] [--out DIR]
+                                          [--samplers independent,sobol] [--variants before,after] [--crop X,Y,W,H]
+                                          [--seed0 1]
 
 Scenes: `cornell` (scenes/cornell.yaml, path), `medium` (scenes/cornell_smoke.yaml with a constant
 chromatic medium in its box, decomposition tracker, volpath_nee), `cloud` (cornell_smoke.yaml as it is,
@@ -22,12 +24,15 @@ with the spread (min..max) of the per-round ratios. A CSV of every render goes t
 "before" switches the media changes of issue 15 off through the integrator's parameters (`light_sampling:
 area`, `rr_threshold: 1`), "after" is the defaults; `--variants before,solid_angle,rr0.1,equiangular,after`
 measures each candidate alone too (`equiangular`: volpath_nee's `equiangular: true`, off by default;
-`smis`: the spectral_mis tracker, `closed_form`: spectral_mis with `closed_form: true`, `cf+eq`: both). The reference renders with the defaults; every
+`smis`: the spectral_mis tracker, `closed_form`: spectral_mis with `closed_form: true`, `cf+eq`: both);
+`noflight` is "after" with the medium's stratified free flights off (`stratify_flights: false`: every
+number of a flight from the PCG stream), e.g.
+`--scenes cloud,cloud_delta,medium,medium_delta,grey --samplers sobol --variants noflight,after`. The reference renders with the defaults; every
 configuration estimates the same image (tests/test_boundaries.c's z-tests check that)."""
 import argparse, csv, os, re, resource, statistics, subprocess, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MURK = os.path.join(ROOT, "build", "core", "murk")
+MURK = os.environ.get("MURK", os.path.join(ROOT, "build", "core", "murk"))  # MURK=path: another build
 
 MEDIUM = ["--set", "media.smoke.type=decomposition", "--set", "media.smoke.density={constant: 1}",
           "--set", "media.smoke.sigma_a=[0.05, 0.1, 0.3]", "--set", "media.smoke.sigma_s=[1.2, 0.8, 0.4]",
@@ -36,6 +41,13 @@ SCENES = {
     "cornell": ("cornell.yaml", []),
     "medium": ("cornell_smoke.yaml", MEDIUM),
     "cloud": ("cornell_smoke.yaml", ["--set", "media.smoke.type=decomposition"]),
+    # only when asked for (--scenes ...): the same media with delta tracking, and a homogeneous grey medium
+    # (delta: there the first tentative collision of a flight is its scattering distance)
+    "cloud_delta": ("cornell_smoke.yaml", ["--set", "media.smoke.type=delta"]),
+    "medium_delta": ("cornell_smoke.yaml", MEDIUM + ["--set", "media.smoke.type=delta"]),
+    "grey": ("cornell_smoke.yaml", ["--set", "media.smoke.type=delta", "--set", "media.smoke.density={constant: 1}",
+                                    "--set", "media.smoke.sigma_a=[0.1, 0.1, 0.1]",
+                                    "--set", "media.smoke.sigma_s=[0.9, 0.9, 0.9]", "--set", "media.smoke.g=0.2"]),
     "lamp": ("lamp.yaml", []),  # written into DIR (LAMP)
     "fog": ("fog_lamp.yaml", ["--set", "integrator.equiangular=false"]),
 }
@@ -72,10 +84,12 @@ VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "inte
             "closed_form": ["--set", "media.{m}.type=spectral_mis", "--set", "media.{m}.closed_form=true"],
             "cf+eq": ["--set", "media.{m}.type=spectral_mis", "--set", "media.{m}.closed_form=true",
                       "--set", "integrator.equiangular=true"],
-            "after": []}
+            "after": [],
+            # stratified free flights (the medium key stratify_flights, default on) switched off alone
+            "noflight": ["--set", "media.{m}.stratify_flights=false"]}
 # Variants that set volpath_nee's or a medium's parameters mean nothing to `path` (the cornell scene,
 # no medium): there they render as "after". {m}: the scene's medium.
-NEE_ONLY = {"equiangular", "smis", "closed_form", "cf+eq"}
+NEE_ONLY = {"equiangular", "smis", "closed_form", "cf+eq", "noflight"}
 MEDIUM_NAME = {"fog": "fog"}  # else "smoke"
 
 
@@ -98,8 +112,8 @@ def render(scene, out, a, spp, seed, extra):
     return run(args)[1]
 
 
-def relmse(img, ref):
-    out, _ = run(["compare", img, ref])
+def relmse(img, ref, crop=None):
+    out, _ = run(["compare", img, ref] + (["--crop", crop] if crop else []))
     m = re.search(r"relMSE ([0-9.eE+-]+)", out)
     if not m:
         sys.exit("murk compare: no relMSE in:\n" + out)
@@ -117,6 +131,8 @@ def main():
     p.add_argument("--variants", default="before,after")
     p.add_argument("--samplers", default=",".join(SAMPLERS))
     p.add_argument("--out", default=os.path.join(ROOT, "bench-out"))
+    p.add_argument("--seed0", type=int, default=1, help="round r renders with seed SEED0 + r")
+    p.add_argument("--crop", help="X,Y,W,H: the relMSE of that rectangle only (murk compare --crop)")
     a = p.parse_args()
     os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "lamp.yaml"), "w") as f:
@@ -138,8 +154,8 @@ def main():
             img = os.path.join(a.out, "ee_%s_%s_%s.exr" % (s, smp, v))
             extra = [] if (s == "cornell" and v in NEE_ONLY) else \
                 [x.replace("{m}", MEDIUM_NAME.get(s, "smoke")) for x in VARIANTS[v]]
-            cpu = render(s, img, a, a.spp, rnd + 1, ["--set", "render.sampler=" + smp] + extra)
-            e = relmse(img, refs[s])
+            cpu = render(s, img, a, a.spp, a.seed0 + rnd, ["--set", "render.sampler=" + smp] + extra)
+            e = relmse(img, refs[s], a.crop)
             rows.append({"round": rnd, "scene": s, "sampler": smp, "variant": v, "relmse": e, "cpu_s": cpu})
             print("round %d  %-8s %-12s %-11s relMSE %.4e  cpu %7.2f s" % (rnd, s, smp, v, e, cpu), flush=True)
     with open(os.path.join(a.out, "equal_error.csv"), "w", newline="") as f:

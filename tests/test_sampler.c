@@ -215,30 +215,9 @@ static void test_disk_convergence(void **state)
 
 static void render_ok(const char *out, const char *const *extra)
 {
-    const char *args[32] = {"render", src_path("scenes/cornell_smoke.yaml"), "-o", out, "--quiet",
-                            "--set", "render.resolution=[40,32]", "--set", "render.sampler=sobol"};
-    size_t n = 9;
-    for (size_t i = 0; extra && extra[i]; i++)
-        args[n++] = extra[i];
-    args[n] = NULL;
-    char *log = NULL;
-    int rc = run_murk_argv(&log, args);
-    if (rc != 0)
-        fprintf(stderr, "murk render failed (%d):\n%s\n", rc, log);
-    assert_int_equal(rc, 0);
-    free(log);
-}
-
-static int same_image(const char *a, const char *b)
-{
-    murk_image A = {0}, B = {0};
-    char err[512];
-    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err))
-        fail_msg("%s", err);
-    int same = A.w == B.w && A.h == B.h && memcmp(A.rgb, B.rgb, 3 * sizeof(float) * (size_t)A.w * (size_t)A.h) == 0;
-    murk_image_free(&A);
-    murk_image_free(&B);
-    return same;
+    const char *args[] = {"render", src_path("scenes/cornell_smoke.yaml"), "-o", out, "--quiet",
+                          "--set", "render.resolution=[40,32]", "--set", "render.sampler=sobol", NULL};
+    run_murk_ok(args, extra);
 }
 
 static const char *out_path(const char *name)
@@ -260,19 +239,19 @@ static void test_render_bitwise(void **state)
     render_ok(ref, one);
     const char *two[] = {"--threads", "2", "--spp", "8", NULL};
     render_ok(out_path("two.exr"), two);
-    assert_true(same_image(ref, out_path("two.exr")));
+    assert_true(same_pixels(ref, out_path("two.exr")));
     const char *timed[] = {"--threads", "2", "--spp", "8", "--time", "600", NULL}; /* passes of 1, then more */
     render_ok(out_path("timed.exr"), timed);
-    assert_true(same_image(ref, out_path("timed.exr")));
+    assert_true(same_pixels(ref, out_path("timed.exr")));
     const char *ck = out_path("ck");
     const char *part[] = {"--threads", "2", "--spp", "3", "--checkpoint", ck, "--every", "0", NULL};
     render_ok(out_path("part.exr"), part);
     const char *rest[] = {"--threads", "2", "--spp", "8", "--resume", ck, NULL};
     render_ok(out_path("resumed.exr"), rest);
-    assert_true(same_image(ref, out_path("resumed.exr")));
+    assert_true(same_pixels(ref, out_path("resumed.exr")));
     const char *indep[] = {"--threads", "2", "--spp", "8", "--set", "render.sampler=independent", NULL};
     render_ok(out_path("indep.exr"), indep);
-    assert_false(same_image(ref, out_path("indep.exr")));
+    assert_false(same_pixels(ref, out_path("indep.exr")));
 }
 
 static void test_scene_key(void **state)

@@ -263,6 +263,34 @@ int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, i
     return ok;
 }
 
+void run_murk_ok(const char *const *args, const char *const *extra)
+{
+    const char *all[65];
+    size_t n = 0;
+    for (size_t i = 0; args[i] && n < 64; i++)
+        all[n++] = args[i];
+    for (size_t i = 0; extra && extra[i] && n < 64; i++)
+        all[n++] = extra[i];
+    all[n] = NULL;
+    char *log = NULL;
+    int rc = run_murk_argv(&log, all);
+    if (rc != 0)
+        fail_msg("murk %s failed (%d):\n%s", args[0], rc, log ? log : "");
+    free(log);
+}
+
+int same_pixels(const char *a, const char *b)
+{
+    murk_image A = {0}, B = {0};
+    char err[1024];
+    if (murk_exr_read(a, &A, err, sizeof err) != 0 || murk_exr_read(b, &B, err, sizeof err) != 0)
+        fail_msg("%s", err);
+    int same = A.w == B.w && A.h == B.h && memcmp(A.rgb, B.rgb, 3 * sizeof(float) * (size_t)A.w * (size_t)A.h) == 0;
+    murk_image_free(&A);
+    murk_image_free(&B);
+    return same;
+}
+
 void assert_same_pixels(const char *a, const char *b)
 {
     murk_image A = {0}, B = {0};

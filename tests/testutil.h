@@ -39,6 +39,9 @@ const char *write_tmp(const char *name, const char *text);
 
 /* The same with the arguments in a NULL-terminated array. */
 int run_murk_argv(char **out, const char *const *args);
+/* Runs murk with the arguments of args and then of extra (both NULL-terminated, extra may be NULL; 64
+ * in all at most) and fails the test, printing murk's output, unless it exits 0. */
+void run_murk_ok(const char *const *args, const char *const *extra);
 /* The same with stdout into *out and stderr into *err apart (both malloc'd). */
 int run_murk_split(char **out, char **err, const char *const *args);
 /* The same for any program: argv[0] is its path (e.g. mpirun's, with murk's among the arguments). */
@@ -46,6 +49,8 @@ int run_argv(char **out, const char *const *argv);
 
 /* Fails the test unless the EXRs a and b hold bitwise the same pixels (their attributes may differ). */
 void assert_same_pixels(const char *a, const char *b);
+/* 1 if they do, 0 if not (the size or a pixel differs); fails the test if one cannot be read. */
+int same_pixels(const char *a, const char *b);
 
 /* A scene rendered with several seeds: per pixel and channel (r, g, b, and their average in channel
  * 3) the mean over the renders and the variance of that mean (sample variance over the seeds / n). */

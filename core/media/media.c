@@ -14,6 +14,7 @@
  *       majorant_factor: 1          # multiplies the majorant grid; < 1 no longer bounds (repaired, warned)
  *       majorant_resolution: 16     # majorant grid cells along the field's longest axis
  *       majorant_repair: true       # cells a factor < 1 left below the density get their exact bound back
+ *       stratify_flights: true      # a free flight's first numbers from the sampler (murk/tracking.h)
  *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
  *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
@@ -226,7 +227,8 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
 /* The keys every medium has, whatever its tracker: read by the core with the same schema reader as a
  * plugin's parameters, and listed with them by `murk plugins TRACKER`. `density` and `transmittance`
  * (maps or names) are read separately (murk_medium_special_keys). */
-enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_MAJORANT_REPAIR, K_COUNT };
+enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_MAJORANT_REPAIR,
+       K_STRATIFY_FLIGHTS, K_COUNT };
 MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
     [K_SIGMA_A] = {"sigma_a", MURK_PARAM_RGB, 0, {0, 0, 0}, NULL, NULL, 0, 1e8, "absorption per unit density"},
     [K_SIGMA_S] = {"sigma_s", MURK_PARAM_RGB, 0, {1, 1, 1}, NULL, NULL, 0, 1e8, "scattering per unit density"},
@@ -239,6 +241,9 @@ MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
     [K_MAJORANT_REPAIR] = {"majorant_repair", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
                            "raise majorant cells that majorant_factor < 1 left below the density to their exact bound "
                            "before rendering; false: trackers repair per flight (unbiased, noisier)"},
+    [K_STRATIFY_FLIGHTS] = {"stratify_flights", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
+                            "a free flight's first distance and collision choice from the sampler (stratified over "
+                            "a pixel's samples with render.sampler: sobol); false: all from the PCG stream"},
 };
 MURK_API const char *const murk_medium_special_keys[2] = {"density", "transmittance"};
 
@@ -312,6 +317,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     md->sigma_s = murk_rgb_scale(murk_rgb3((float)core[K_SIGMA_S].f[0], (float)core[K_SIGMA_S].f[1],
                                            (float)core[K_SIGMA_S].f[2]), scale);
     md->g = (float)core[K_G].f[0];
+    md->stratify_flights = core[K_STRATIFY_FLIGHTS].f[0] != 0.0;
     double mf = core[K_MAJORANT_FACTOR].f[0];
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);

@@ -15,9 +15,9 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
                            char *err, size_t errlen);
 
 /* The keys every medium has, read by the core whatever the tracker (sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution, majorant_repair), as a parameter schema; and the two keys read apart from it
+ * majorant_factor, majorant_resolution, majorant_repair, stratify_flights), as a parameter schema; and the two keys read apart from it
  * ("density", "transmittance"). `murk plugins TRACKER` lists them. */
-#define MURK_MEDIUM_NCORE 7
+#define MURK_MEDIUM_NCORE 8
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
 extern const char *const murk_medium_special_keys[2];
 void murk_media_free(murk_scene *s);

@@ -95,6 +95,11 @@ enum { PT_SLOT_HERO = 1 };
 enum { PT_SLOT_LIGHT_CHOICE, PT_SLOT_LIGHT_POINT, PT_SLOT_DIRECTION, PT_SLOT_LOBE, PT_SLOT_ROULETTE,
        PT_SLOTS_PER_EVENT };
 #define PT_SLOT(depth, which) (2u + (uint32_t)(depth) * PT_SLOTS_PER_EVENT + (uint32_t)(which))
+/* A free flight's own slot, sought before the tracker's sample(): a medium with stratify_flights takes the
+ * flight's first numbers there (a 2-D point: the first distance and choice; murk/tracking.h); trackers
+ * draw the rest, and transmittance estimators all, from the PCG stream. depth scattering events and `crossings` boundary
+ * crossings so far name the path's segment; padding slots are hashed, so any unused number serves. */
+#define PT_SLOT_FLIGHT(depth, crossings) (0x20000000u + (uint32_t)(depth) * 1024u + ((uint32_t)(crossings) & 1023u))
 
 /* ---- small helpers ------------------------------------------------------------------------- */
 
@@ -437,6 +442,7 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     seg.tmax = tmax;
     murk_medium_event ev;
     st->ctx.beta = st->beta;
+    murk_sample_seek(rng, PT_SLOT_FLIGHT(st->depth, st->crossings));
     m->vt->sample(m->self, &seg, &st->ctx, rng, &ev);
     if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t))) {
         broken(h, "medium", m->name, "free-flight weight");

@@ -13,6 +13,11 @@
  *            is tracked with the control lowered below the density seen (murk/tracking.h's per-flight
  *            repair; noisier than the clamp) and murk says so once.
  *
+ * The medium's common keys are read by the core. With stratify_flights (murk/tracking.h) the flight's
+ * first draw takes the sampler slot's first coordinate — the control distance of the first cell with a
+ * control, else that cell's first residual distance (not carried over cells as murk_collisions' is) —
+ * and the first residual collision's real/null choice its second.
+ *
  * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
  * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
  * mu_r = max density x max_c sigma_t - c sigma_min. The first of a control event (real in every channel)
@@ -95,6 +100,8 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     murk_majorant_walk w;
     h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
     float ta, tb, dmax, dmin, cscale = 1.0f, boost = 1.0f;
+    int first = murk_flight_stratified(d); /* the flight's first numbers from the sampler (murk/tracking.h) */
+    float uc = -1.0f;
     long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         if (++steps > MURK_WATCHDOG_ITERATIONS) {
@@ -106,14 +113,14 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
         decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
-        float tc = rate_c > 0.0f ? murk_advance(ta, murk_sample_exp(rng, rate_c)) : INFINITY;
+        float tc = rate_c > 0.0f ? murk_advance(ta, murk_flight_exp(rng, &first, &uc, rate_c)) : INFINITY;
         for (float t = ta;;) {
             if (++steps > MURK_WATCHDOG_ITERATIONS) {
                 murk_tracker_watchdog(&m->base, "a free flight");
                 murk_event_kill(ev, t);
                 return;
             }
-            float tr = mu_r > 0.0f ? murk_advance(t, murk_sample_exp(rng, mu_r)) : INFINITY;
+            float tr = mu_r > 0.0f ? murk_advance(t, murk_flight_exp(rng, &first, &uc, mu_r)) : INFINITY;
             if (!(tc < tb) && !(tr < tb))
                 break;
             count->collisions++; /* a control or a residual collision */
@@ -140,7 +147,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             if (amax > 1.0f)
                 murk_warn_majorant(&m->base, "decomposition tracking weights");
             float q = murk_collision_prob(&m->base, a, ctx, ev->weight);
-            if (murk_rng_float(rng) < q) {
+            if (murk_flight_choice(rng, &uc) < q) {
                 for (int k = 0; k < 3; k++)
                     ev->weight.c[k] *= st.c[k] > 0.0f ? a[k] / q * (d->sigma_s.c[k] / st.c[k]) : 0.0f;
                 ev->scattered = 1;

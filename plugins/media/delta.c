@@ -1,7 +1,9 @@
 /* delta — delta (Woodcock) tracking for free flights, residual ratio tracking for transmittance.
  *
  * Parameters: none of its own. The medium's common keys (density, sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution) are read by the core.
+ * majorant_factor, majorant_resolution, majorant_repair, stratify_flights) are read by the core; with
+ * stratify_flights the first tentative collision's optical depth and its real/null choice come from the
+ * flight's sampler slot (murk_collisions, murk/tracking.h), as in spectral, spectral_mis and naive_spectral.
  *
  * Tentative collisions are drawn with the majorant mu = max density of the grid cell x max channel of
  * sigma_t, cell by cell along the ray. A tentative collision at x is real with probability
@@ -55,7 +57,7 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
         if (amax > 1.0f)
             murk_warn_majorant(m, "delta tracking weights");
         float q = murk_collision_prob(m, a, ctx, ev->weight);
-        if (murk_rng_float(rng) < q) {
+        if (murk_collisions_choice(&c, rng) < q) {
             for (int k = 0; k < 3; k++) /* sigma_s,k(x) / (mu q): the albedo for grey extinction */
                 ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q);
             ev->scattered = 1;

@@ -45,7 +45,7 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
         if (a > 1.0f)
             murk_warn_majorant(m, "per-channel delta tracking weights");
         float q = murk_real_prob(a, 1.0f - a);
-        if (murk_rng_float(rng) < q) {
+        if (murk_collisions_choice(&c, rng) < q) {
             ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (c.mu * q);
             ev->scattered = 1;
             ev->t = t;

@@ -77,7 +77,7 @@ static void spectral_sample(const void *self, const murk_ray *ray, const murk_pa
         if (neg)
             murk_warn_majorant(&m->base, "spectral tracking gives negative null weights to");
         float pa = pick(m->scheme, sa, hist), ps = pick(m->scheme, ss, hist), pn = pick(m->scheme, sn, hist);
-        float sum = pa + ps + pn, u = murk_rng_float(rng) * sum;
+        float sum = pa + ps + pn, u = murk_collisions_choice(&c, rng) * sum;
         if (!(sum > 0.0f) || u < pa) { /* absorbed (or no weight left in any channel): the path ends */
             ev->weight = murk_rgb1(0.0f);
             ev->scattered = 1;

@@ -57,14 +57,17 @@ static int smis_create(const murk_host *host, const murk_medium_data *data, cons
  * there with weight_k = d sigma_s,k e^(-s_k x) / (s_h e^(-s_h x)) and pdf ratio s_k e^(-s_k x) /
  * (s_h e^(-s_h x)), else it passes the cell with both e^(-s_k L) / e^(-s_h L). Channel k's technique is
  * the same thing with its own s_k, and the tracking that follows shares one majorant for every
- * channel, so the ratios of the whole flight stay those of one technique per channel. */
+ * channel, so the ratios of the whole flight stay those of one technique per channel. One optical depth
+ * tau for the hero, drawn once (a stratified flight's first number: murk_flight_float) and used up cell
+ * by cell (memoryless: the same as a fresh draw per cell), so the stratification reaches the scattering
+ * distance wherever it lies. *first says whether the flight's slot is still unused. */
 static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, int hero, murk_rng *rng, murk_medium_event *ev,
-                            float *from)
+                            float *from, int *first)
 {
     const murk_host *h = m->host;
     murk_majorant_walk w;
     h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
-    float a, b, dmax, dmin;
+    float a, b, dmax, dmin, tau = -1.0f, uc = -1.0f;
     for (long i = 0; i < MURK_WATCHDOG_ITERATIONS && h->walk_next(&w, &a, &b, &dmax, &dmin); i++) {
         if (!(dmax > 0.0f))
             continue;
@@ -72,8 +75,11 @@ static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, int hero
             *from = a;
             return 0;
         }
+        if (tau < 0.0f)
+            tau = -log1pf(-murk_flight_float(rng, first, &uc));
         float sh = dmax * m->sigma_t.c[hero], len = b - a;
-        float x = sh > 0.0f ? -log1pf(-murk_rng_float(rng)) / sh : INFINITY;
+        float x = sh > 0.0f ? tau / sh : INFINITY;
+        tau -= sh * len;
         if (x < len) {
             float ph = sh * expf(-sh * x);
             for (int k = 0; k < 3; k++) {
@@ -103,10 +109,12 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
     if (!(m->smax > 0.0f))
         return;
     murk_ray rest = *ray;
-    if (((const smis *)self)->closed_form && smis_closed_form(m, ray, hero, rng, ev, &rest.tmin))
+    int first = murk_flight_stratified(m->d);
+    if (((const smis *)self)->closed_form && smis_closed_form(m, ray, hero, rng, ev, &rest.tmin, &first))
         return;
     murk_collisions c;
     murk_collisions_init(&c, m, &rest, m->smax); /* one majorant for every channel */
+    c.first = first; /* 0 if the closed-form part took the flight's slot */
     float t, dens;
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a[3], q[3], amax = 0.0f;
@@ -117,7 +125,7 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
         }
         if (amax > 1.0f)
             murk_warn_majorant(m, "spectral MIS weights");
-        if (murk_rng_float(rng) < q[hero]) {
+        if (murk_collisions_choice(&c, rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
                 ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
                 ev->pdf_ratio.c[k] *= q[k] / q[hero];

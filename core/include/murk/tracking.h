@@ -81,6 +81,53 @@ static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb
 /* Distance to the next event of a Poisson process of rate mu > 0. */
 static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-murk_rng_float(rng)) / mu; }
 
+/* Stratified free flights (the medium's `stratify_flights` key, murk_medium_data.stratify_flights). The
+ * integrator seeks (murk_sample_seek) to a slot of the flight's own before sample(); a stratified flight
+ * takes its FIRST random numbers from that slot and every later one from the PCG stream, so the
+ * collision loop's unbounded use never moves the integrator's slots. With render.sampler sobol the slot
+ * is a 2-D point, stratified over the pixel's samples: its first coordinate gives the flight's first
+ * distance, its second the choice (real or null, absorbed or scattered) at the flight's first
+ * collision — jointly stratified, which measured far better on chromatic media than the distance alone
+ * (docs/results.md). It changes which numbers a flight uses, never its method or its distribution.
+ * With render.sampler independent murk_sample_1d is murk_rng_float in call order and the choice's
+ * number is drawn where it always was: the numbers are those of an unstratified flight. A tracker keeps
+ * `int first = murk_flight_stratified(d); float uc = -1;` per flight and draws with murk_flight_float /
+ * murk_flight_exp and murk_flight_choice (murk_collisions does this itself: murk_collisions_choice). */
+static inline int murk_flight_stratified(const murk_medium_data *d)
+{
+    return MURK_HAS(d->size, murk_medium_data, stratify_flights) && d->stratify_flights;
+}
+
+/* A uniform number in [0, 1): if *first (which it clears) the slot's — with sobol its first coordinate,
+ * the second kept in *uc for murk_flight_choice — else the PCG stream's. */
+static inline float murk_flight_float(murk_rng *rng, int *first, float *uc)
+{
+    if (!*first)
+        return murk_rng_float(rng);
+    *first = 0;
+    if (rng->sampler != MURK_SAMPLER_SOBOL)
+        return murk_sample_1d(rng);
+    float u[2];
+    murk_sample_2d(rng, u);
+    *uc = u[1];
+    return u[0];
+}
+
+/* murk_sample_exp with murk_flight_float's number. */
+static inline float murk_flight_exp(murk_rng *rng, int *first, float *uc, float mu)
+{
+    return -log1pf(-murk_flight_float(rng, first, uc)) / mu;
+}
+
+/* The number for a collision's choice: the slot's second coordinate if murk_flight_float left one in
+ * *uc (which it clears), else the PCG stream's. */
+static inline float murk_flight_choice(murk_rng *rng, float *uc)
+{
+    float u = *uc;
+    *uc = -1.0f;
+    return u >= 0.0f ? u : murk_rng_float(rng);
+}
+
 /* t + step, but at least the next float above t: a loop that steps t always advances (the watchdog
  * contract, murk/plugin.h), even where a step is below the float spacing of t. */
 static inline float murk_advance(float t, float step)
@@ -169,7 +216,13 @@ static inline void murk_warn_majorant(const murk_tracker *t, const char *what)
 
 /* Tentative collisions along a ray: a Poisson process whose rate in each majorant cell is
  * mu = (the cell's maximum density) x sigma x boost, walked cell by cell (delta tracking's proposal);
- * boost starts at 1 and only murk_collisions_raise changes it. */
+ * boost starts at 1 and only murk_collisions_raise changes it. A stratified flight (murk_flight_stratified)
+ * with render.sampler sobol draws its first tentative collision's majorant optical depth tau = -ln(1 - u)
+ * once, from the slot, and carries what is left of it over the cells it passes (tau - mu x the cell's
+ * length; exponential distances are memoryless, so this is the same process as a fresh draw per cell),
+ * so the slot's stratification reaches the first collision wherever it lies; later collisions draw
+ * afresh from the PCG stream in each cell. With independent numbers each cell draws afresh, as before
+ * the key existed (the same numbers in the same order). */
 typedef struct murk_collisions {
     const murk_tracker *tr;
     const murk_ray *ray;
@@ -178,6 +231,9 @@ typedef struct murk_collisions {
     float boost; /* this flight's majorant multiplier, raised where the majorant failed */
     long steps;  /* collisions and cells so far */
     int stopped; /* 1 if the watchdog ended the walk (MURK_WATCHDOG_ITERATIONS): kill the path */
+    int first;   /* 1 until the flight's first number is drawn, if the flight is stratified */
+    float tau;   /* the stratified first draw's optical depth still to go (carried over cells), < 0: none */
+    float uc;    /* the first collision's choice number (the slot's second coordinate), < 0: none */
     murk_counters *count, scratch; /* the medium's cost counters (murk_tracker_counters) */
 } murk_collisions;
 
@@ -192,6 +248,8 @@ static inline void murk_collisions_init(murk_collisions *c, const murk_tracker *
     c->boost = 1.0f;
     c->steps = 0;
     c->stopped = 0;
+    c->first = murk_flight_stratified(tr->d);
+    c->tau = c->uc = -1.0f;
     c->count = murk_tracker_counters(tr->host, tr->d, &c->scratch);
     tr->host->walk_init(tr->d->density, ray, ray->tmin, ray->tmax, &c->walk);
 }
@@ -221,7 +279,16 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
             return 0;
         }
         if (c->mu > 0.0f) {
-            c->t = murk_advance(c->t, murk_sample_exp(rng, c->mu));
+            float t0 = c->t, tau;
+            int carry = c->tau >= 0.0f;
+            if (carry) {
+                tau = c->tau;
+            } else {
+                carry = c->first && rng->sampler == MURK_SAMPLER_SOBOL;
+                tau = -log1pf(-murk_flight_float(rng, &c->first, &c->uc));
+            }
+            c->t = murk_advance(c->t, tau / c->mu);
+            c->tau = carry && !(c->t < c->tb) ? fmaxf(0.0f, tau - c->mu * (c->tb - t0)) : -1.0f;
             if (c->t < c->tb) {
                 c->count->collisions++;
                 *t = c->t;
@@ -236,6 +303,11 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
         c->mu = dmax * c->sigma * c->boost;
     }
 }
+
+/* The number for the choice at the collision murk_collisions_next() just returned (real or null,
+ * absorbed or scattered): at the first collision of a stratified flight with sobol the slot's second
+ * coordinate, else the PCG stream's. Draw it with this, not murk_rng_float. */
+static inline float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
 
 /* Ratio tracking (Novak et al. 2014) over (ray->tmin, ray->tmax) with majorant segments from the
  * walk; extra: a second density-proportional extinction that is handled in closed form instead
