@@ -65,8 +65,10 @@ static void put_rgb(const char *label, murk_rgb c) { printf("%s [%g, %g, %g]", l
 
 static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
 {
-    static const char *const own[] = {"type", "density", "transmittance", "sigma_a", "sigma_s", "scale", "g",
-                                      "majorant_factor", "majorant_resolution"};
+    /* the keys the core reads (shown below), not the tracker's own: "type", the special keys, the schema */
+    const char *own[3 + MURK_MEDIUM_NCORE] = {"type", murk_medium_special_keys[0], murk_medium_special_keys[1]};
+    for (int i = 0; i < MURK_MEDIUM_NCORE; i++)
+        own[3 + i] = murk_medium_core_params[i].name;
     char buf[256];
     printf("  %s\n    tracker        ", murk_printable(buf, sizeof buf, nm->name));
     put_block(nm->plugin, block, own, sizeof own / sizeof own[0]);
@@ -105,6 +107,7 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
     printf("\n    majorant       %dx%dx%d cells, majorant_factor %g; largest majorant %g (extinction %g x density "
            "%g x factor)\n", g->res[0], g->res[1], g->res[2], factor,
            (double)(st * murk_field_max(f) * factor), st, murk_field_max(f));
+    printf("    flights        stratify_flights %s\n", md->stratify_flights ? "true" : "false");
 }
 
 static const char *medium_name(const murk_medium *m) { return m ? m->name : "vacuum"; }
