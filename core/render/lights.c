@@ -43,9 +43,9 @@ void murk_lights_build(murk_scene *s)
         }
         for (uint32_t t = 0; t < sh->ntris; t++) {
             const uint32_t *ix = &sh->idx[3 * t];
-            murk_vec3 a = murk_v3(sh->pos[3 * ix[0]], sh->pos[3 * ix[0] + 1], sh->pos[3 * ix[0] + 2]);
-            murk_vec3 b = murk_v3(sh->pos[3 * ix[1]], sh->pos[3 * ix[1] + 1], sh->pos[3 * ix[1] + 2]);
-            murk_vec3 c = murk_v3(sh->pos[3 * ix[2]], sh->pos[3 * ix[2] + 1], sh->pos[3 * ix[2] + 2]);
+            murk_vec3 a = murk_shape_vertex(sh, ix[0]);
+            murk_vec3 b = murk_shape_vertex(sh, ix[1]);
+            murk_vec3 c = murk_shape_vertex(sh, ix[2]);
             l.prim = t;
             l.p0 = a;
             l.e1 = murk_sub(b, a);
@@ -173,13 +173,13 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
     memset(ls, 0, sizeof *ls);
     if (s->nlights == 0 || s->light_power <= 0.0f)
         return 0;
-    size_t lo = 0, hi = s->nlights; /* find i with cdf[i] <= u0 < cdf[i+1] */
-    while (hi - lo > 1) {
-        size_t mid = (lo + hi) / 2;
-        if (s->light_cdf[mid] <= u[0])
-            lo = mid;
-        else
-            hi = mid;
+    /* the last i with cdf[i] <= u0 (cdf[0] = 0; a NaN u0 gives 0): a binary search whose steps are
+     * conditional moves, not branches (u0 is random, so a branch is mispredicted every other time) */
+    size_t lo = 0, len = s->nlights;
+    while (len > 1) {
+        size_t half = len / 2;
+        lo = s->light_cdf[lo + half] <= u[0] ? lo + half : lo;
+        len -= half;
     }
     while (lo > 0 && s->lights[lo].pmf <= 0.0f) /* never land on a zero-power light */
         lo--;
