@@ -31,6 +31,23 @@
 #include <string.h>
 #include <time.h>
 
+/* CPU seconds of the calling thread (the Embree sides and the media figure) and of the whole process (the
+ * murk side: its render thread's; the main thread waits in pthread_join meanwhile). On a machine shared
+ * with other work, wall time would count the others' time slices. */
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double proc_cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
 {
     struct RTCBounds b;
@@ -40,7 +57,7 @@ static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
     enum { BATCH = 1 << 16 };
     struct RTCRayHit *rays = murk_xmalloc(BATCH * sizeof *rays);
     uint64_t n = 0, hits = 0;
-    double t0 = murk_now(), traced = 0;
+    double traced = 0;
     while (traced < seconds) {
         for (int i = 0; i < BATCH; i++) { /* generate outside the timed part */
             struct RTCRayHit *r = &rays[i];
@@ -52,17 +69,16 @@ static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
             r->ray.tnear = 0, r->ray.tfar = INFINITY, r->ray.time = 0, r->ray.mask = ~0u, r->ray.id = 0, r->ray.flags = 0;
             r->hit.geomID = RTC_INVALID_GEOMETRY_ID;
         }
-        double ts = murk_now();
+        double ts = cpu_now();
         struct RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         for (int i = 0; i < BATCH; i++) {
             rtcIntersect1(s->rtc, &ctx, &rays[i]);
             hits += rays[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
         }
-        traced += murk_now() - ts;
+        traced += cpu_now() - ts;
         n += BATCH;
     }
-    (void)t0;
     free(rays);
     *nrays = n;
     return (double)n / traced + 0 * (double)hits;
@@ -113,7 +129,7 @@ static double replay_side(const murk_scene *s, const replay *rp, double seconds)
         memcpy(rays, rp->rh, rp->n * sizeof *rays); /* outside the timed part: Embree writes tfar and hit */
         for (size_t i = 0; i < rp->n; i++)
             rays[i].hit.geomID = rays[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        double ts = murk_now();
+        double ts = cpu_now();
         for (size_t i = 0; i < rp->n; i++) {
             struct RTCIntersectContext ctx;
             rtcInitIntersectContext(&ctx);
@@ -125,7 +141,7 @@ static double replay_side(const murk_scene *s, const replay *rp, double seconds)
                 hits += rays[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
             }
         }
-        traced += murk_now() - ts;
+        traced += cpu_now() - ts;
         n += rp->n;
     }
     free(rays);
@@ -151,8 +167,9 @@ static double murk_side(murk_scene *s, double seconds, int *spp)
 {
     murk_render_opts o = {.threads = 1, .time_limit = seconds};
     murk_render_result r;
+    double t0 = proc_cpu_now();
     murk_render(s, &o, &r);
-    double rps = (double)r.rays / r.seconds;
+    double rps = (double)r.rays / (proc_cpu_now() - t0);
     *spp = r.spp;
     free(r.rgb);
     return rps;
@@ -161,14 +178,6 @@ static double murk_side(murk_scene *s, double seconds, int *spp)
 /* ---- media: tracker against a bare loop over the same majorant grid ------------------------------ */
 
 enum { NSEG = 1 << 14 };
-
-/* This thread's CPU seconds: on a machine shared with other work, wall time would count the others. */
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct segs {
     murk_ray ray[NSEG];
