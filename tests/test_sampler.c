@@ -145,16 +145,6 @@ static uint32_t ref_rev(uint32_t x)
     return y;
 }
 
-static uint32_t ref_lk(uint32_t x, uint32_t seed)
-{
-    x ^= x * 0x3d20adeau;
-    x += seed;
-    x *= (seed >> 16) | 1u;
-    x ^= x * 0x05526c56u;
-    x ^= x * 0x53a22864u;
-    return x;
-}
-
 static uint32_t ref_sobol1(uint32_t i) /* the generator matrix's columns v_j = v_(j-1) ^ (v_(j-1) >> 1) */
 {
     uint32_t v = 1u << 31, x = 0;
@@ -164,6 +154,7 @@ static uint32_t ref_sobol1(uint32_t i) /* the generator matrix's columns v_j = v
     return x;
 }
 
+/* (the Laine-Karras hash is math.h's own, murk_lk_hash_: the checksum pins its constants) */
 static float ref_u24(uint32_t x) { return (float)(x >> 8) / 16777216.0f; }
 
 /* Slot `slot` of sample `index` of `pixel`: u[0] (a 1-D slot's number) and u[1]. */
@@ -171,9 +162,9 @@ static void ref_point(uint64_t seed, uint64_t pixel, uint32_t index, uint32_t sl
 {
     uint64_t scramble = ref_mix(ref_mix(seed ^ 0x5851f42d4c957f2dull) ^ pixel);
     uint64_t h = ref_mix(scramble + 0x9e3779b97f4a7c15ull * ((uint64_t)slot + 1u));
-    uint32_t i = ref_rev(ref_lk(ref_rev(index), (uint32_t)h)); /* Owen-scrambled index */
-    u[0] = ref_u24(ref_rev(ref_lk(ref_rev(ref_rev(i)), (uint32_t)(h >> 32)))); /* Sobol 0 is the reversal */
-    u[1] = ref_u24(ref_rev(ref_lk(ref_rev(ref_sobol1(i)), (uint32_t)ref_mix(h))));
+    uint32_t i = ref_rev(murk_lk_hash_(ref_rev(index), (uint32_t)h)); /* Owen-scrambled index */
+    u[0] = ref_u24(ref_rev(murk_lk_hash_(ref_rev(ref_rev(i)), (uint32_t)(h >> 32)))); /* Sobol 0 is the reversal */
+    u[1] = ref_u24(ref_rev(murk_lk_hash_(ref_rev(ref_sobol1(i)), (uint32_t)ref_mix(h))));
 }
 
 static void test_sobol_definition(void **state)
