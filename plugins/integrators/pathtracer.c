@@ -17,15 +17,21 @@
 
 #include "murk/material.h"
 
-const murk_param murk_pt_params[MURK_PT_NPARAMS] = {
-    [MURK_PT_MAX_DEPTH] = {"max_depth", MURK_PARAM_INT, 0, {64, 0, 0}, NULL, NULL, 1, 100000,
-                           "most scattering events (surface or medium) per path"},
-    [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000,
-                          "scattering events before Russian roulette may end a path"},
-    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0,
-                                "NEE: every light triangle by area, or rectangular lights by solid angle"},
-    [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1,
+#define PT_SHARED_PARAMS \
+    [MURK_PT_MAX_DEPTH] = {"max_depth", MURK_PARAM_INT, 0, {64, 0, 0}, NULL, NULL, 1, 100000, \
+                           "most scattering events (surface or medium) per path"}, \
+    [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000, \
+                          "scattering events before Russian roulette may end a path"}, \
+    [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0, \
+                                "NEE: every light triangle by area, or rectangular lights by solid angle"}, \
+    [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1, \
                               "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
+
+const murk_param murk_pt_params[MURK_PT_NPARAMS] = {PT_SHARED_PARAMS};
+const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
+    PT_SHARED_PARAMS
+    [MURK_PT_EQUIANGULAR] = {"equiangular", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
+                             "also sample each medium segment equiangularly towards a light point (MIS)"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -62,6 +68,7 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->rr_threshold = (float)params[MURK_PT_RR_THRESHOLD].f[0];
     pt->nee = nee;
     pt->media = media;
+    pt->equiangular = nee && media && params[MURK_PT_EQUIANGULAR].f[0] != 0.0;
     *self = pt;
     return 0;
 }
@@ -80,6 +87,11 @@ void murk_pt_destroy(void *self)
  * Russian roulette after the event (1-D). Trackers and transmittance estimators take their numbers
  * from the PCG stream (murk_rng_float), outside the slots. */
 enum { PT_SLOT_HERO = 1 };
+/* With equiangular sampling, each medium segment's own slots, apart from the events' (slots are hashed:
+ * any unique number will do): k = 0 the light choice and 1 the point (2-D) of its reference point, 2 the
+ * distance, 3 the light choice and 4 the point (2-D) of the NEE at the equiangular vertex. */
+#define PT_SLOT_EQUIANGULAR(depth, crossings, k) \
+    (0x40000000u + ((uint32_t)(depth) * 1024u + ((uint32_t)(crossings) & 1023u)) * 8u + (uint32_t)(k))
 enum { PT_SLOT_LIGHT_CHOICE, PT_SLOT_LIGHT_POINT, PT_SLOT_DIRECTION, PT_SLOT_LOBE, PT_SLOT_ROULETTE,
        PT_SLOTS_PER_EVENT };
 #define PT_SLOT(depth, which) (2u + (uint32_t)(depth) * PT_SLOTS_PER_EVENT + (uint32_t)(which))
@@ -234,37 +246,166 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
     return v->mat->vt->pdf(v->mat->self, v->hit, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
 }
 
-/* Next-event estimation from v: a light point, the transmittance to it, the power heuristic against
- * the vertex's own sampling. */
-static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, murk_rng *rng)
+static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v,
+                                   const murk_light_sample *ls, murk_rng *rng);
+
+/* Next-event estimation from v with the numbers of slot `slot` (the light choice, then the point),
+ * its value times w added to the path: a light point, the transmittance to it, the power heuristic
+ * against the vertex's own sampling. */
+static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, uint32_t slot,
+                         float w, murk_rng *rng)
 {
-    const murk_host *h = pt->host;
     float u[3];
-    murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE));
+    murk_sample_seek(rng, slot);
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
-    if (!h->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
-        return;
-    murk_rgb f = vertex_f(h, v, ls.wi);
+    if (w > 0.0f && pt->host->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
+        add_light(st, light_sample_value(pt, scene, st, v, &ls, rng), w);
+}
+
+/* f T Le / pdf of the light sample ls at v, weighted by the power heuristic against the vertex's own
+ * sampling (zero when the light is blocked or behind). */
+static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v,
+                                   const murk_light_sample *ls, murk_rng *rng)
+{
+    const murk_host *h = pt->host;
+    murk_rgb f = vertex_f(h, v, ls->wi);
     if (!finite3(f)) {
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "BSDF value");
-        return;
+        return murk_rgb1(0.0f);
     }
     if (murk_rgb_is_black(f))
-        return;
+        return f;
     /* a light behind a transmitting surface is reached through the medium on that side */
-    const murk_medium *m = v->mat && murk_dot(ls.wi, v->offset_n) < 0.0f ? v->behind : st->medium;
-    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls.wi, ls.dist), m, &st->ctx, rng);
+    const murk_medium *m = v->mat && murk_dot(ls->wi, v->offset_n) < 0.0f ? v->behind : st->medium;
+    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m, &st->ctx, rng);
     if (murk_rgb_is_black(T))
-        return;
-    float pdf = vertex_pdf(h, v, ls.wi);
+        return T;
+    float pdf = vertex_pdf(h, v, ls->wi);
     if (!isfinite(pdf)) {
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
+        return murk_rgb1(0.0f);
+    }
+    return murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(f, T), ls->le), power_heuristic(ls->pdf, pdf) / ls->pdf);
+}
+
+/* ---- equiangular sampling along a medium segment (Kulla and Fajardo 2012) ----------------------
+ * Before a free flight over [0, tmax) through the path's medium, volpath_nee with `equiangular` draws a
+ * reference point q on a light (a light sample from the segment's start, its own slots). Two strategies
+ * then estimate the light scattered into the ray along the segment:
+ *   free flight  the tracker's own flight; if it scatters at t, NEE there as always, weighted w_ff(t);
+ *   equiangular  a distance t ~ p_eq(t) = D / ((th_b - th_a) (D^2 + (t - delta)^2)) on the part of the
+ *                segment the majorant grid says can scatter, [a, b] (delta: q's foot on the ray, D its
+ *                distance from the ray); there the density's sigma_s, the transmittance from the
+ *                segment's start (the medium's estimator) and an NEE of its own, weighted w_eq(t) / p_eq.
+ * w_eq = p_eq / (p_ff + p_eq), w_ff = 1 - w_eq, with p_ff(t) = s exp(-s (t - a)) for one extinction s per
+ * segment (the mean over channels of sigma_t times the mean of the majorant grid's max and min over
+ * [a, b]): the free flight's own pdf only in a grey homogeneous medium, an approximation elsewhere.
+ * Unbiased all the same: given q the weights are a deterministic function of t that sums to one wherever
+ * either strategy samples (all MIS needs), and both NEEs are independent of q, each an unbiased estimate
+ * of the direct light at its vertex. (So q only steers where the equiangular vertex goes; the NEEs keep
+ * their bounded light sampling, and a ray that passes close to q does not meet the 1 / D^2 of a light
+ * point used for both.) Within each NEE the light sample is weighted against phase sampling as
+ * everywhere, so free flight x light, free flight x phase and equiangular x light sum to one at every
+ * distance and direction. */
+typedef struct eq_segment {
+    float a, b; /* where equiangular sampling samples: b > a, else nowhere (w_ff = 1) */
+    float delta, D, th_a, th_b, s;
+} eq_segment;
+
+static float eq_pdf(const eq_segment *sg, float t)
+{
+    if (!(sg->b > sg->a) || t < sg->a || t > sg->b)
+        return 0.0f;
+    float x = t - sg->delta;
+    return sg->D / ((sg->th_b - sg->th_a) * (sg->D * sg->D + x * x));
+}
+
+/* w_ff(t): the free flight's share of a scattering vertex at t. */
+static float eq_w_ff(const eq_segment *sg, float t)
+{
+    float pe = eq_pdf(sg, t);
+    if (!(pe > 0.0f))
+        return 1.0f;
+    float pf = sg->s * expf(-sg->s * (t - sg->a));
+    return pf / (pf + pe);
+}
+
+/* Sets up the segment [0, tmax) of st->ray in st->medium (q, [a, b], s) and adds the equiangular
+ * estimate. */
+static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, float tmax, murk_rng *rng,
+                        eq_segment *sg)
+{
+    const murk_host *h = pt->host;
+    const murk_medium *m = st->medium;
+    sg->a = sg->b = 0.0f;
+    float u[3];
+    murk_sample_seek(rng, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 0));
+    u[0] = murk_sample_1d(rng);
+    murk_sample_2d(rng, u + 1);
+    murk_light_sample ls;
+    if (!h->sample_light_with(scene, st->ray.o, u, pt->light_strategy, &ls))
+        return;
+    murk_vec3 q = murk_madd(st->ray.o, ls.wi, ls.dist);
+    /* where the medium can scatter along the segment, and its mean density there */
+    murk_majorant_walk w;
+    h->walk_init(m->data->density, &st->ray, st->ray.tmin, tmax, &w);
+    float ta, tb, dmax, dmin, a = INFINITY, b = 0.0f;
+    double sum = 0.0, len = 0.0;
+    for (long i = 0; i < MURK_WATCHDOG_ITERATIONS && h->walk_next(&w, &ta, &tb, &dmax, &dmin); i++) {
+        if (!(dmax > 0.0f))
+            continue;
+        a = murk_minf(a, ta);
+        b = murk_maxf(b, tb);
+        if (isfinite(tb)) {
+            sum += 0.5 * ((double)dmax + (double)dmin) * ((double)tb - (double)ta);
+            len += (double)tb - (double)ta;
+        } else if (len == 0.0) { /* an unbounded medium: its first cell's density */
+            sum = 0.5 * ((double)dmax + (double)dmin);
+            len = 1.0;
+        }
+    }
+    if (!(b > a) || !(len > 0.0))
+        return;
+    murk_vec3 oq = murk_sub(q, st->ray.o);
+    float delta = murk_dot(oq, st->ray.d);
+    float D = murk_length(murk_sub(oq, murk_mul(st->ray.d, delta)));
+    if (!(D > 1e-6f * murk_maxf(1.0f, maxabs(q))))
+        return; /* q on the ray's line: free flights alone */
+    float th_a = atan2f(a - delta, D), th_b = isfinite(b) ? atan2f(b - delta, D) : 0.5f * MURK_PI;
+    if (!(th_b > th_a))
+        return;
+    *sg = (eq_segment){a, b, delta, D, th_a, th_b, (float)(sum / len) * mean3(murk_rgb_add(m->data->sigma_a, m->data->sigma_s))};
+    /* the equiangular vertex */
+    murk_sample_seek(rng, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 2));
+    float t = delta + D * tanf(th_a + murk_sample_1d(rng) * (th_b - th_a));
+    float pe = eq_pdf(sg, t);
+    if (!(pe > 0.0f) || !(t < tmax))
+        return;
+    murk_vec3 x = murk_madd(st->ray.o, st->ray.d, t);
+    float dens = h->density(m->data->density, x);
+    if (!(dens > 0.0f))
+        return;
+    murk_ray seg = st->ray;
+    seg.tmax = t;
+    st->ctx.beta = st->beta;
+    murk_rgb T = murk_medium_transmittance(m, &seg, &st->ctx, rng);
+    if (!finite3(T)) {
+        broken(h, "medium", m->name, "transmittance");
         return;
     }
-    float w = power_heuristic(ls.pdf, pdf) / ls.pdf;
-    add_light(st, murk_rgb_mul(murk_rgb_mul(f, T), ls.le), w);
+    if (murk_rgb_is_black(T))
+        return;
+    vertex v = {0};
+    v.p = x;
+    v.wo = murk_neg(st->ray.d);
+    v.g = m->data->g;
+    path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
+    at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
+    at.L = murk_rgb1(0.0f);
+    sample_light(pt, scene, &at, &v, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 3), (1.0f - eq_w_ff(sg, t)) / pe, rng);
+    st->L = murk_rgb_add(st->L, at.L);
 }
 
 /* ---- events ---------------------------------------------------------------------------------- */
@@ -272,7 +413,8 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
 enum { PT_END, PT_PASSED, PT_SCATTERED };
 
 /* A free flight through st->medium up to tmax (the next surface, or INFINITY). */
-static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, float tmax, murk_rng *rng)
+static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, float tmax, const eq_segment *sg,
+                         murk_rng *rng)
 {
     const murk_host *h = pt->host;
     const murk_medium *m = st->medium;
@@ -297,8 +439,8 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
     v.wo = murk_neg(st->ray.d);
     v.g = m->data->g;
-    if (pt->nee)
-        sample_light(pt, scene, st, &v, rng);
+    if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t), rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
@@ -345,7 +487,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
         v.wo_local.z = 1e-6f;
     if (pt->nee)
-        sample_light(pt, scene, st, &v, rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), 1.0f, rng);
     float u[3];
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
@@ -427,7 +569,10 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
         murk_hit hit;
         int found = h->intersect(scene, &st.ray, &hit);
         if (st.medium) {
-            int ev = medium_vertex(pt, scene, &st, found ? hit.t : INFINITY, rng);
+            eq_segment sg = {0};
+            if (pt->equiangular && st.depth < pt->max_depth)
+                equiangular(pt, scene, &st, found ? hit.t : INFINITY, rng, &sg);
+            int ev = medium_vertex(pt, scene, &st, found ? hit.t : INFINITY, &sg, rng);
             if (ev == PT_END)
                 break;
             if (ev == PT_SCATTERED) {

@@ -37,6 +37,9 @@
 /* The parameters all three integrators share (documented in each plugin's comment block). */
 enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
+/* volpath_nee's: the shared ones, then its own. */
+enum { MURK_PT_EQUIANGULAR = MURK_PT_NPARAMS, MURK_PT_NEE_NPARAMS };
+extern const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS];
 
 typedef struct murk_pt {
     const murk_host *host;
@@ -45,9 +48,12 @@ typedef struct murk_pt {
     int media; /* track media (0: surfaces only, boundaries are invisible) */
     int light_strategy; /* MURK_LIGHT_* for NEE and the MIS weight of emission found (0: area, the default) */
     float rr_threshold; /* Russian roulette's survival probability is min(1, weight / rr_threshold) (0: 1) */
+    int equiangular;    /* volpath_nee: equiangular distance sampling towards a light point per medium
+                         * segment, MIS-combined with the tracker's free flights (pathtracer.c) */
 } murk_pt;
 
-/* create() for an integrator with the given strategy; destroy() for all of them. */
+/* create() for an integrator with the given strategy (params: murk_pt_nee_params when nee, else
+ * murk_pt_params); destroy() for all of them. */
 int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int media, void **self, char *err,
                    size_t errlen);
 void murk_pt_destroy(void *self);
