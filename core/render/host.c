@@ -17,8 +17,8 @@
 #include <emmintrin.h>
 #endif
 
-/* initial-exec: libmurk is loaded with the program, never dlopen()ed, so these are fixed offsets from the
- * thread pointer; the default model for a shared library's TLS calls __tls_get_addr on every access. */
+/* initial-exec, like murk_thread_counters (host.h): a fixed offset from the thread pointer, where the
+ * default model for a shared library's TLS calls __tls_get_addr on every access (every ray, here). */
 #if defined(__GNUC__)
 #define MURK_TLS_IE __attribute__((tls_model("initial-exec")))
 #else
