@@ -1,7 +1,8 @@
 /* test_reliability.c — regressions for issue 10's classes, each a case that broke a promise before:
  *   1. values that pass validation but break float arithmetic: a medium too dense for float t (hung
- *      every tracker), a camera beyond what Embree accepts (SIGABRT), free-flight loops that must
- *      advance and stop at the watchdog's cap (bounded-time tests under alarm());
+ *      every tracker), a camera beyond what Embree accepts (SIGABRT) and the host's range check of every
+ *      ray against its scalar statement, free-flight loops that must advance and stop at the
+ *      watchdog's cap (bounded-time tests under alarm());
  *   2. allocations sized by untrusted headers or endless input: declared-size checks on PNG, EXR and
  *      grid headers, and devices/FIFOs refused without reading or blocking;
  *   3. files left behind or replaced: the EXR and PNG are written both or neither, temporaries are
@@ -11,6 +12,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -20,6 +22,8 @@
 #include <unistd.h>
 
 #include "atomic.h"
+#include "host.h"
+#include "scene.h"
 #include "density.h"
 #include "image.h"
 #include "limit.h"
@@ -124,6 +128,50 @@ static void t_camera_far(void **state)
         assert_null(strstr(out, "'up'"));
         free(out);
     }
+}
+
+/* host.c hands Embree only rays it can carry (Embree asserts, SIGABRT, on an origin or direction beyond
+ * about 1.8e18 or not finite, a NaN or negative tnear, a NaN tfar). The check runs on every ray, so it is
+ * two SSE compares: here against its scalar statement on the edge values of each of the 8 floats, through
+ * the host's intersect() and occluded(). A refused ray is not traced (no hit, not occluded) nor counted. */
+static int scalar_traceable(const murk_ray *r)
+{
+    const float big = 1e18f;
+    return fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
+           fabsf(r->d.y) <= big && fabsf(r->d.z) <= big && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
+}
+
+static void t_ray_range(void **state)
+{
+    (void)state;
+    char err[1024];
+    murk_scene *s = murk_scene_load(write_tmp("range.yaml", "murk: 1\nmaterials: { w: { type: diffuse } }\n"
+                                              "shapes: [ { type: box, min: [-1, -1, -1], max: [1, 1, 1], material: w } ]\n"),
+                                    NULL, 0, err, sizeof err);
+    if (!s)
+        fail_msg("%s", err);
+    const murk_host *h = murk_host_table();
+    const float edge[] = {0.0f, -0.0f, 1e18f, -1e18f, nextafterf(1e18f, INFINITY), -nextafterf(1e18f, INFINITY),
+                          INFINITY, -INFINITY, NAN, -NAN, 1e-45f};
+    int n = (int)(sizeof edge / sizeof edge[0]), checked = 0;
+    for (int f = 0; f < 8; f++)
+        for (int e = 0; e < n; e++) {
+            murk_ray r = {murk_v3(0.1f, 0.2f, 0.3f), murk_v3(0.0f, 0.6f, 0.8f), 0.0f, INFINITY};
+            float *v = &r.o.x; /* o, d, tmin, tmax: 8 floats */
+            v[f] = edge[e];
+            int want = scalar_traceable(&r);
+            murk_hit hit;
+            murk_host_thread_reset();
+            int found = h->intersect(s, &r, &hit);
+            h->occluded(s, &r);
+            assert_int_equal(murk_host_thread_rays(), want ? 2u : 0u);
+            if (!want)
+                assert_int_equal(found, 0);
+            checked++;
+        }
+    murk_host_thread_reset();
+    murk_scene_free(s);
+    printf("ray range: %d rays, each traced exactly when the scalar test accepts it\n", checked);
 }
 
 /* A fake host for driving tracking.h: one majorant segment [t0, t1) of density dmax. */
@@ -570,6 +618,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(t_medium_too_dense),
         cmocka_unit_test(t_camera_far),
+        cmocka_unit_test(t_ray_range),
         cmocka_unit_test(t_tracker_progress_and_watchdog),
         cmocka_unit_test(t_png_declared_size),
         cmocka_unit_test(t_exr_declared_size),

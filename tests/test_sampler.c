@@ -1,6 +1,7 @@
 /* test_sampler.c — the sampler of murk/math.h (issue 15): the padded Owen-scrambled Sobol points are
  * stratified in every slot, differ per pixel and per seed, integrate a disk faster than independent
- * numbers; the independent sampler is the PCG stream in call order; renders with sobol are bitwise
+ * numbers; the points are bit for bit those of the definition (a slow reference here), whatever fast
+ * formulation math.h uses; the independent sampler is the PCG stream in call order; renders with sobol are bitwise
  * identical for 1 and 2 threads, for --time passes and for a checkpoint resumed; render.sampler is
  * read and checked like every scene key. And the solid-angle sampling of rectangular lights
  * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
@@ -19,6 +20,9 @@
 /* The slots the integrators use (pathtracer.c: camera 0, hero 1, then 5 per scattering event) for the
  * first 12 events, and more: every slot is made the same way. */
 enum { NSLOTS = 2 + 5 * 12 };
+
+/* test_sobol_definition's checksum of the points (murk 0.1.0, plugin ABI 1.4, the sampler's first version) */
+#define SOBOL_CHECKSUM 0x5f3ec6738da35b7bull
 
 static void point(uint32_t sampler, uint64_t seed, uint64_t pixel, uint32_t index, uint32_t slot, float u[2])
 {
@@ -119,6 +123,77 @@ static void test_decorrelated(void **state)
             assert_true(fabs(r) < tol);
             assert_int_equal(same, 0);
         }
+}
+
+/* The Sobol points exactly as murk/math.h's comment defines them, computed here bit by bit with no
+ * shortcut (bit loops for the reversals, Sobol dimension 1 from its direction numbers), against
+ * murk_sample_1d/2d: any faster formulation of the inline sampler must give the same bits. And a
+ * checksum of the points, so that the definition itself cannot drift (images are pinned by it). */
+static uint64_t ref_mix(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+static uint32_t ref_rev(uint32_t x)
+{
+    uint32_t y = 0;
+    for (int b = 0; b < 32; b++)
+        y |= ((x >> b) & 1u) << (31 - b);
+    return y;
+}
+
+static uint32_t ref_sobol1(uint32_t i) /* the generator matrix's columns v_j = v_(j-1) ^ (v_(j-1) >> 1) */
+{
+    uint32_t v = 1u << 31, x = 0;
+    for (int j = 0; j < 32; j++, v ^= v >> 1)
+        if ((i >> j) & 1u)
+            x ^= v;
+    return x;
+}
+
+/* (the Laine-Karras hash is math.h's own, murk_lk_hash_: the checksum pins its constants) */
+static float ref_u24(uint32_t x) { return (float)(x >> 8) / 16777216.0f; }
+
+/* Slot `slot` of sample `index` of `pixel`: u[0] (a 1-D slot's number) and u[1]. */
+static void ref_point(uint64_t seed, uint64_t pixel, uint32_t index, uint32_t slot, float u[2])
+{
+    uint64_t scramble = ref_mix(ref_mix(seed ^ 0x5851f42d4c957f2dull) ^ pixel);
+    uint64_t h = ref_mix(scramble + 0x9e3779b97f4a7c15ull * ((uint64_t)slot + 1u));
+    uint32_t i = ref_rev(murk_lk_hash_(ref_rev(index), (uint32_t)h)); /* Owen-scrambled index */
+    u[0] = ref_u24(ref_rev(murk_lk_hash_(ref_rev(ref_rev(i)), (uint32_t)(h >> 32)))); /* Sobol 0 is the reversal */
+    u[1] = ref_u24(ref_rev(murk_lk_hash_(ref_rev(ref_sobol1(i)), (uint32_t)ref_mix(h))));
+}
+
+static void test_sobol_definition(void **state)
+{
+    (void)state;
+    uint64_t sum = 0xcbf29ce484222325ull; /* FNV-1a over the bits of every point */
+    int n = 0;
+    for (uint64_t seed = 0; seed < 3; seed++)
+        for (uint64_t pixel = 0; pixel < 300; pixel += 7)
+            for (uint32_t index = 0; index < 300; index += (index < 64 ? 1 : 61)) {
+                murk_rng r1, r2;
+                murk_sampler_start(&r1, MURK_SAMPLER_SOBOL, seed, pixel, index * 2654435761u >> (index < 64 ? 26 : 0));
+                r2 = r1;
+                for (uint32_t slot = 0; slot < 24; slot++) {
+                    float u[2], want[2];
+                    murk_sample_2d(&r1, u);
+                    ref_point(seed, pixel, r1.index, slot, want);
+                    assert_memory_equal(u, want, sizeof u);
+                    float v = murk_sample_1d(&r2);
+                    assert_memory_equal(&v, want, sizeof v);
+                    uint32_t bits[2];
+                    memcpy(bits, u, sizeof bits);
+                    for (int c = 0; c < 2; c++)
+                        sum = (sum ^ bits[c]) * 0x100000001b3ull;
+                    n++;
+                }
+            }
+    printf("sobol definition: %d points equal to the reference, checksum %016llx\n", n, (unsigned long long)sum);
+    assert_true(sum == SOBOL_CHECKSUM);
 }
 
 /* The independent sampler (and a stream murk_rng_seed made) is the PCG stream in call order. */
@@ -399,6 +474,7 @@ int main(void)
         cmocka_unit_test(test_stratified),
         cmocka_unit_test(test_decorrelated),
         cmocka_unit_test(test_independent_is_pcg),
+        cmocka_unit_test(test_sobol_definition),
         cmocka_unit_test(test_disk_convergence),
         cmocka_unit_test(test_rect_light_chi2),
         cmocka_unit_test(test_scene_key),

@@ -5,6 +5,7 @@
 #include "util.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void embree_error(void *user, enum RTCError code, const char *str)
@@ -45,6 +46,16 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
             }
             memcpy(v, sh->pos, 3u * sh->nverts * sizeof(float));
             memcpy(ix, sh->idx, 3u * sh->ntris * sizeof(uint32_t));
+            /* each triangle's unit normal as host.c's fill_hit() computed it per hit (same operations,
+             * so the same floats): one load there instead of a cross product and a normalisation */
+            free(sh->ng);
+            sh->ng = murk_xmalloc(3u * sh->ntris * sizeof(float));
+            for (uint32_t t = 0; t < sh->ntris; t++) {
+                const uint32_t *tv = &sh->idx[3 * t];
+                murk_vec3 n = murk_triangle_normal(murk_shape_vertex(sh, tv[0]), murk_shape_vertex(sh, tv[1]),
+                                                   murk_shape_vertex(sh, tv[2]));
+                sh->ng[3 * t] = n.x, sh->ng[3 * t + 1] = n.y, sh->ng[3 * t + 2] = n.z;
+            }
         }
         rtcCommitGeometry(g);
         unsigned id = rtcAttachGeometry(s->rtc, g);

@@ -7,6 +7,19 @@
 
 #include "scene.h"
 
+/* Vertex i of a triangle shape. */
+static inline murk_vec3 murk_shape_vertex(const murk_shape *sh, uint32_t i)
+{
+    return murk_v3(sh->pos[3 * i], sh->pos[3 * i + 1], sh->pos[3 * i + 2]);
+}
+
+/* The unit geometric normal of triangle (a, b, c): (b - a) x (c - a), normalised. accel.c stores it per
+ * triangle (murk_shape.ng) and host.c uses the stored one, so both must compute it here. */
+static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3 c)
+{
+    return murk_normalize(murk_cross(murk_sub(b, a), murk_sub(c, a)));
+}
+
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 void murk_lights_build(murk_scene *s);

@@ -9,12 +9,37 @@
 #include "util.h"
 
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
-static _Thread_local uint64_t thread_rays;
+/* initial-exec, like murk_thread_counters (host.h): a fixed offset from the thread pointer, where the
+ * default model for a shared library's TLS calls __tls_get_addr on every access (every ray, here). */
+#if defined(__GNUC__)
+#define MURK_TLS_IE __attribute__((tls_model("initial-exec")))
+#else
+#define MURK_TLS_IE
+#endif
+static _Thread_local uint64_t thread_rays MURK_TLS_IE;
 _Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
+
+/* The rays being recorded (murk_host_record_rays), or NULL: one predictable branch per ray otherwise. */
+static murk_ray_record *ray_record;
+
+void murk_host_record_rays(murk_ray_record *rec) { ray_record = rec; }
+
+static void record_ray(const murk_ray *r, int occluded)
+{
+    size_t k = atomic_fetch_add(&ray_record->n, 1);
+    if (k < ray_record->cap) {
+        ray_record->ray[k] = *r;
+        ray_record->occluded[k] = (unsigned char)occluded;
+    }
+}
 
 uint64_t murk_host_thread_rays(void) { return thread_rays; }
 
@@ -115,11 +140,6 @@ static void host_log(int level, const char *fmt, ...)
 
 static void host_tex_eval(const murk_texture *t, const murk_hit *hit, float out[3]) { murk_texture_eval(t, hit, out); }
 
-static murk_vec3 vtx(const murk_shape *sh, uint32_t i)
-{
-    return murk_v3(sh->pos[3 * i], sh->pos[3 * i + 1], sh->pos[3 * i + 2]);
-}
-
 static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRayHit *rh, murk_hit *h)
 {
     const murk_shape *sh = &s->shapes[rh->hit.geomID];
@@ -136,9 +156,10 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
     } else {
         const uint32_t *ix = &sh->idx[3 * h->prim];
         float b1 = rh->hit.u, b2 = rh->hit.v, b0 = 1.0f - b1 - b2;
-        murk_vec3 a = vtx(sh, ix[0]), b = vtx(sh, ix[1]), c = vtx(sh, ix[2]);
+        murk_vec3 a = murk_shape_vertex(sh, ix[0]), b = murk_shape_vertex(sh, ix[1]), c = murk_shape_vertex(sh, ix[2]);
         h->p = murk_add(murk_add(murk_mul(a, b0), murk_mul(b, b1)), murk_mul(c, b2));
-        h->ng = murk_normalize(murk_cross(murk_sub(b, a), murk_sub(c, a)));
+        h->ng = sh->ng ? murk_v3(sh->ng[3 * h->prim], sh->ng[3 * h->prim + 1], sh->ng[3 * h->prim + 2])
+                       : murk_triangle_normal(a, b, c);
         h->n = h->ng;
         if (sh->nrm) {
             const float *n0 = &sh->nrm[3 * ix[0]], *n1 = &sh->nrm[3 * ix[1]], *n2 = &sh->nrm[3 * ix[2]];
@@ -179,11 +200,23 @@ static void to_embree(const murk_ray *r, struct RTCRay *er)
  * a NaN or negative tnear, a NaN tfar. Scene coordinates stay within MURK_MAX_COORD (limit.h), but a
  * path may still wander far out through an unbounded medium: such a ray is not traced (it hits
  * nothing and nothing occludes it), and murk says so once. */
+_Static_assert(sizeof(murk_ray) == 8 * sizeof(float), "murk_ray is o, d, tmin, tmax: 8 floats");
+
 static int ray_traceable(const murk_ray *r)
 {
+#if defined(__SSE2__)
+    /* the six coordinates as two vectors (murk_ray is 8 floats: o, d, tmin, tmax): |x| <= 1e18 is false
+     * for NaN, like the scalar test */
+    const __m128 big = _mm_set1_ps(1e18f), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 lo = _mm_loadu_ps(&r->o.x), hi = _mm_loadu_ps(&r->d.y); /* ox oy oz dx, dy dz tmin tmax */
+    int in = _mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(lo, abs), big)) == 0xf &&
+             (_mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(hi, abs), big)) & 3) == 3;
+#else
     const float big = 1e18f;
-    int ok = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
-             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
+    int in = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
+             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big;
+#endif
+    int ok = in && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
     if (!ok)
         murk_warn_once("a ray beyond the range Embree accepts (origin or direction beyond 1e18, or NaN) was not "
                        "traced: a path left the scene through an unbounded medium");
@@ -202,6 +235,8 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     thread_rays++;
+    if (ray_record)
+        record_ray(r, 0);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
     fill_hit(s, r, &rh, h);
@@ -218,6 +253,8 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     to_embree(r, &er);
     rtcOccluded1(s->rtc, &ctx, &er);
     thread_rays++;
+    if (ray_record)
+        record_ray(r, 1);
     return er.tfar < 0.0f;
 }
 

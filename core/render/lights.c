@@ -43,9 +43,9 @@ void murk_lights_build(murk_scene *s)
         }
         for (uint32_t t = 0; t < sh->ntris; t++) {
             const uint32_t *ix = &sh->idx[3 * t];
-            murk_vec3 a = murk_v3(sh->pos[3 * ix[0]], sh->pos[3 * ix[0] + 1], sh->pos[3 * ix[0] + 2]);
-            murk_vec3 b = murk_v3(sh->pos[3 * ix[1]], sh->pos[3 * ix[1] + 1], sh->pos[3 * ix[1] + 2]);
-            murk_vec3 c = murk_v3(sh->pos[3 * ix[2]], sh->pos[3 * ix[2] + 1], sh->pos[3 * ix[2] + 2]);
+            murk_vec3 a = murk_shape_vertex(sh, ix[0]);
+            murk_vec3 b = murk_shape_vertex(sh, ix[1]);
+            murk_vec3 c = murk_shape_vertex(sh, ix[2]);
             l.prim = t;
             l.p0 = a;
             l.e1 = murk_sub(b, a);
@@ -168,59 +168,83 @@ static float cone_one_minus_cos(float r, float d)
     return sin2 / (1.0f + cosm);
 }
 
+/* Kept out of murk_lights_sample() so that its common path (a triangle by area) does not pay for their
+ * stack frames (srect: 14 doubles) in its prologue. */
+#if defined(__GNUC__)
+#define MURK_NOINLINE __attribute__((noinline))
+#else
+#define MURK_NOINLINE
+#endif
+
+/* A direction uniformly in the cone sphere light l subtends from p. */
+static MURK_NOINLINE int sample_sphere(const murk_light *l, murk_vec3 p, const float u[3], murk_light_sample *ls)
+{
+    murk_vec3 dc = murk_sub(l->center, p);
+    float d = murk_length(dc);
+    if (d <= l->radius * 1.0001f)
+        return 0; /* inside (or on) an outward-emitting sphere: it sends nothing this way */
+    murk_vec3 w = murk_mul(dc, 1.0f / d), t, b;
+    murk_basis(w, &t, &b);
+    float omc = cone_one_minus_cos(l->radius, d);
+    float one_minus_cos = u[1] * omc;
+    float cost = 1.0f - one_minus_cos;
+    float sint = sqrtf(murk_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+    float phi = 2.0f * MURK_PI * u[2];
+    murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
+    /* distance to the near intersection along dir */
+    float bq = murk_dot(dir, dc);
+    float disc = l->radius * l->radius - (d * d - bq * bq);
+    float dist = bq - sqrtf(murk_maxf(0.0f, disc));
+    ls->wi = dir;
+    ls->dist = murk_maxf(dist, 0.0f);
+    ls->le = l->le;
+    ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
+    return ls->pdf > 0.0f && isfinite(ls->pdf);
+}
+
+/* A point uniformly in the solid angle of rectangle light l seen from p; -1 where it is sampled by area
+ * instead (MIN_RECT_OMEGA, PLANE_EPS). */
+static MURK_NOINLINE int sample_rect(const murk_light *l, murk_vec3 p, const float u[3], murk_light_sample *ls)
+{
+    srect r;
+    if (!srect_setup(l, p, &r) || !(r.omega >= MIN_RECT_OMEGA))
+        return -1;
+    murk_vec3 q = srect_sample(&r, p, u[1], u[2]);
+    murk_vec3 d = murk_sub(q, p);
+    float dist = murk_length(d);
+    if (!(dist > 0.0f))
+        return 0;
+    ls->wi = murk_mul(d, 1.0f / dist);
+    ls->dist = dist;
+    ls->le = l->le;
+    ls->pdf = (float)(l->rect_pmf / r.omega);
+    return isfinite(ls->pdf) && ls->pdf > 0.0f;
+}
+
 int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int strategy, murk_light_sample *ls)
 {
     memset(ls, 0, sizeof *ls);
     if (s->nlights == 0 || s->light_power <= 0.0f)
         return 0;
-    size_t lo = 0, hi = s->nlights; /* find i with cdf[i] <= u0 < cdf[i+1] */
-    while (hi - lo > 1) {
-        size_t mid = (lo + hi) / 2;
-        if (s->light_cdf[mid] <= u[0])
-            lo = mid;
-        else
-            hi = mid;
+    /* the last i with cdf[i] <= u0 (cdf[0] = 0; a NaN u0 gives 0): a binary search whose steps are
+     * conditional moves, not branches (u0 is random, so a branch is mispredicted every other time) */
+    size_t lo = 0, len = s->nlights;
+    while (len > 1) {
+        size_t half = len / 2;
+        lo = s->light_cdf[lo + half] <= u[0] ? lo + half : lo;
+        len -= half;
     }
     while (lo > 0 && s->lights[lo].pmf <= 0.0f) /* never land on a zero-power light */
         lo--;
     const murk_light *l = &s->lights[lo];
     if (l->pmf <= 0.0f)
         return 0;
-    if (l->sphere) {
-        murk_vec3 dc = murk_sub(l->center, p);
-        float d = murk_length(dc);
-        if (d <= l->radius * 1.0001f)
-            return 0; /* inside (or on) an outward-emitting sphere: it sends nothing this way */
-        murk_vec3 w = murk_mul(dc, 1.0f / d), t, b;
-        murk_basis(w, &t, &b);
-        float omc = cone_one_minus_cos(l->radius, d);
-        float one_minus_cos = u[1] * omc;
-        float cost = 1.0f - one_minus_cos;
-        float sint = sqrtf(murk_maxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
-        float phi = 2.0f * MURK_PI * u[2];
-        murk_vec3 dir = murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, w);
-        /* distance to the near intersection along dir */
-        float bq = murk_dot(dir, dc);
-        float disc = l->radius * l->radius - (d * d - bq * bq);
-        float dist = bq - sqrtf(murk_maxf(0.0f, disc));
-        ls->wi = dir;
-        ls->dist = murk_maxf(dist, 0.0f);
-        ls->le = l->le;
-        ls->pdf = l->pmf / (2.0f * MURK_PI * omc);
-        return ls->pdf > 0.0f && isfinite(ls->pdf);
-    }
-    srect r;
-    if (strategy == MURK_LIGHT_SOLID_ANGLE && l->rect && srect_setup(l, p, &r) && r.omega >= MIN_RECT_OMEGA) {
-        murk_vec3 q = srect_sample(&r, p, u[1], u[2]);
-        murk_vec3 d = murk_sub(q, p);
-        float dist = murk_length(d);
-        if (!(dist > 0.0f))
-            return 0;
-        ls->wi = murk_mul(d, 1.0f / dist);
-        ls->dist = dist;
-        ls->le = l->le;
-        ls->pdf = (float)(l->rect_pmf / r.omega);
-        return isfinite(ls->pdf) && ls->pdf > 0.0f;
+    if (l->sphere)
+        return sample_sphere(l, p, u, ls);
+    if (strategy == MURK_LIGHT_SOLID_ANGLE && l->rect) {
+        int ok = sample_rect(l, p, u, ls);
+        if (ok >= 0)
+            return ok;
     }
     float su = sqrtf(u[1]);
     murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));

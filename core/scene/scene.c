@@ -11,6 +11,7 @@ void murk_shape_free(murk_shape *sh)
     free(sh->pos);
     free(sh->uv);
     free(sh->nrm);
+    free(sh->ng);
     free(sh->idx);
 }
 

@@ -24,6 +24,7 @@ typedef struct murk_shape {
     float *pos;                                /* 3*nverts (triangle shapes) */
     float *uv;                                 /* 2*nverts or NULL */
     float *nrm;                                /* 3*nverts or NULL (mesh shading normals) */
+    float *ng;                                 /* 3*ntris unit geometric normals (accel.c; fill_hit's) */
     uint32_t *idx;                             /* 3*ntris */
     murk_vec3 center;                          /* sphere */
     float radius;

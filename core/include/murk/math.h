@@ -193,10 +193,21 @@ static inline void murk_sample_2d(murk_rng *r, float u[2])
         u[1] = murk_rng_float(r);
         return;
     }
-    uint32_t i;
-    uint64_t h;
-    u[0] = murk_u24_(murk_sample_slot_(r, &i, &h));
-    u[1] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_sobol1_reversed(i), (uint32_t)murk_hash64(h))));
+    /* u[0] = u24(reverse(lk(i, hi32(h)))), u[1] = u24(reverse(lk(sobol1_reversed(i), lo32(hash(h))))), as
+     * murk_sample_slot_() and murk_sample_1d() compute them, with the two independent reversals done as one
+     * 64-bit reversal of the pair (reversing a:b gives reverse(b):reverse(a)) */
+    uint64_t h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(r->dim++ + 1u));
+    uint32_t i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)h));
+    uint64_t ab = ((uint64_t)murk_lk_hash_(i, (uint32_t)(h >> 32)) << 32) |
+                  murk_lk_hash_(murk_sobol1_reversed(i), (uint32_t)murk_hash64(h));
+    ab = ((ab >> 1) & 0x5555555555555555ull) | ((ab & 0x5555555555555555ull) << 1);
+    ab = ((ab >> 2) & 0x3333333333333333ull) | ((ab & 0x3333333333333333ull) << 2);
+    ab = ((ab >> 4) & 0x0f0f0f0f0f0f0f0full) | ((ab & 0x0f0f0f0f0f0f0f0full) << 4);
+    ab = ((ab >> 8) & 0x00ff00ff00ff00ffull) | ((ab & 0x00ff00ff00ff00ffull) << 8);
+    ab = ((ab >> 16) & 0x0000ffff0000ffffull) | ((ab & 0x0000ffff0000ffffull) << 16);
+    ab = (ab >> 32) | (ab << 32);
+    u[0] = murk_u24_((uint32_t)ab);
+    u[1] = murk_u24_((uint32_t)(ab >> 32));
 }
 /* The next slot as one number in [0, 1). */
 static inline float murk_sample_1d(murk_rng *r)
