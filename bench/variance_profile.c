@@ -40,7 +40,7 @@
 #include "scene.h"
 #include "util.h"
 
-#include "camera_ray.h"
+#include "camera.h"
 #include "host.h"
 
 #include <math.h>
@@ -123,7 +123,7 @@ static void run(const murk_scene *s, const murk_pt *pt, const int crop[4], int s
             for (int k = 0; k < spp; k++) {
                 murk_rng rng;
                 murk_ray r;
-                camera_sample_start(s, x, y, k, &rng, &r);
+                murk_camera_sample(s, x, y, (uint32_t)k, &rng, &r);
                 memset(cur, 0, sizeof cur);
                 ended = 0;
                 murk_rgb L = murk_pt_li(pt, s, &r, &rng);

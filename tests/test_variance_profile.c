@@ -15,7 +15,7 @@
 
 #include "testutil.h"
 
-#include "../bench/camera_ray.h"
+#include "camera.h"
 #include "host.h"
 #include "scene.h"
 
@@ -71,7 +71,7 @@ static void test_sum(void **state)
             for (int k = 0; k < 2; k++) { /* 256 pixels x 2 samples = 512 paths */
                 murk_rng rng;
                 murk_ray r;
-                camera_sample_start(s, x, y, k, &rng, &r);
+                murk_camera_sample(s, x, y, (uint32_t)k, &rng, &r);
                 memset(tap_sum, 0, sizeof tap_sum);
                 memset(tap_terms, 0, sizeof tap_terms);
                 tap_abs = 0.0;
@@ -155,8 +155,8 @@ static void test_plugins(void **state)
             for (int k = 0; k < 4; k++, n++) {
                 murk_rng a, b;
                 murk_ray ra, rb;
-                camera_sample_start(s, x, y, k, &a, &ra);
-                camera_sample_start(s, x, y, k, &b, &rb);
+                murk_camera_sample(s, x, y, (uint32_t)k, &a, &ra);
+                murk_camera_sample(s, x, y, (uint32_t)k, &b, &rb);
                 murk_rgb La = s->integrator_vt->li(s->integrator, s, &ra, &a); /* the plugin */
                 murk_rgb Lb = murk_pt_li(&pt, s, &rb, &b);                   /* this program's, tapped */
                 differ += memcmp(La.c, Lb.c, sizeof La.c) != 0;

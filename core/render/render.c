@@ -12,6 +12,7 @@
  * sample order: no pixel is ever summed across ranks, so the sums are the single-process ones bit for
  * bit. Messages per tile and pass: one TILE (16 bytes + 28 per pixel of state) and one RESULT (8 + 28
  * per pixel). After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
+#include "camera.h"
 #include "checkpoint.h"
 #include "error.h"
 #include "host.h"
@@ -128,17 +129,6 @@ static void tile_done(job *j, int t, double seconds)
     atomic_fetch_add(&j->done, 1);
 }
 
-static void camera_ray(const murk_scene *s, float fx, float fy, murk_ray *r)
-{
-    float aspect = (float)s->width / (float)s->height;
-    float px = (2.0f * fx / (float)s->width - 1.0f) * s->cam_tan * aspect;
-    float py = (1.0f - 2.0f * fy / (float)s->height) * s->cam_tan;
-    r->o = s->cam_from;
-    r->d = murk_normalize(murk_add(s->cam_w, murk_add(murk_mul(s->cam_u, px), murk_mul(s->cam_v, py))));
-    r->tmin = 0.0f;
-    r->tmax = INFINITY;
-}
-
 static void *worker(void *arg)
 {
     job *j = arg;
@@ -169,11 +159,8 @@ static void *worker(void *arg)
                 uint32_t n = j->count[pix];
                 for (int k = j->spp0; k < j->spp1; k++) {
                     murk_rng rng;
-                    float jit[2]; /* slot 0 of the sampler (murk/math.h) */
-                    murk_sampler_start(&rng, s->sampler, s->seed, pix, (uint32_t)k);
-                    murk_sample_2d(&rng, jit);
                     murk_ray r;
-                    camera_ray(s, (float)x + jit[0], (float)y + jit[1], &r);
+                    murk_camera_sample(s, x, y, (uint32_t)k, &rng, &r);
                     murk_rgb L = s->integrator_vt->li(s->integrator, s, &r, &rng);
                     if (j->dump && k < j->dump_spp)
                         memcpy(j->dump + 3 * (pix * (size_t)j->dump_spp + (size_t)k), L.c, sizeof L.c);
