@@ -21,8 +21,8 @@ mean relMSE, median CPU time and the efficiency 1 / (relMSE x time) relative to 
 (the first sampler, the first variant: independent, before),
 with the spread (min..max) of the per-round ratios. A CSV of every render goes to DIR/equal_error.csv.
 
-"before" switches the media changes of issue 15 off through the integrator's parameters (`light_sampling:
-area`, `rr_threshold: 1`), "after" is the defaults; `--variants before,solid_angle,rr0.1,equiangular,after`
+"before" switches the media changes of issue 15 off through the integrator's and the medium's parameters
+(`light_sampling: area`, `rr_threshold: 1`, `stratify_flights: false`), "after" is the defaults; `--variants before,solid_angle,rr0.1,equiangular,after`
 measures each candidate alone too (`equiangular`: volpath_nee's `equiangular: true`, off by default;
 `smis`: the spectral_mis tracker, `closed_form`: spectral_mis with `closed_form: true`, `cf+eq`: both);
 `noflight` is "after" with the medium's stratified free flights off (`stratify_flights: false`: every
@@ -75,7 +75,8 @@ shapes:
 """
 SAMPLERS = ["independent", "sobol"]
 # The media candidates, each alone, as integrator parameters (murk plugins volpath_nee):
-VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=1"],
+VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=1",
+                       "--set", "media.{m}.stratify_flights=false"],
             "solid_angle": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=1"],
             "rr0.1": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=0.1"],
             "both": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=0.1"],
@@ -87,10 +88,18 @@ VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "inte
             "after": [],
             # stratified free flights (the medium key stratify_flights, default on) switched off alone
             "noflight": ["--set", "media.{m}.stratify_flights=false"]}
-# Variants that set volpath_nee's or a medium's parameters mean nothing to `path` (the cornell scene,
-# no medium): there they render as "after". {m}: the scene's medium.
-NEE_ONLY = {"equiangular", "smis", "closed_form", "cf+eq", "noflight"}
+# {m}: the scene's medium. The cornell scene (`path`, no medium) drops the settings of a medium and of
+# volpath_nee's own parameters: there those variants render as "after".
 MEDIUM_NAME = {"fog": "fog"}  # else "smoke"
+
+
+def variant_args(scene, v):
+    args = [x.replace("{m}", MEDIUM_NAME.get(scene, "smoke")) for x in VARIANTS[v]]
+    if scene != "cornell":
+        return args
+    pairs = [args[i:i + 2] for i in range(0, len(args), 2)]
+    return [x for p in pairs if not (p[1].startswith("media.") or p[1].startswith("integrator.equiangular"))
+            for x in p]
 
 
 def run(args):
@@ -152,8 +161,7 @@ def main():
     for rnd in range(a.rounds):
         for (s, smp, v) in configs:
             img = os.path.join(a.out, "ee_%s_%s_%s.exr" % (s, smp, v))
-            extra = [] if (s == "cornell" and v in NEE_ONLY) else \
-                [x.replace("{m}", MEDIUM_NAME.get(s, "smoke")) for x in VARIANTS[v]]
+            extra = variant_args(s, v)
             cpu = render(s, img, a, a.spp, a.seed0 + rnd, ["--set", "render.sampler=" + smp] + extra)
             e = relmse(img, refs[s], a.crop)
             rows.append({"round": rnd, "scene": s, "sampler": smp, "variant": v, "relmse": e, "cpu_s": cpu})
