@@ -59,7 +59,7 @@ typedef struct murk_medium_data {
     float g;                      /* Henyey-Greenstein asymmetry of the phase function */
     const murk_density *density;  /* the field with its majorant/minorant grid (majorant_factor applied) */
     const char *name;             /* the medium's name in the scene, for messages */
-    /* Appended after ABI 1.4's fields (read it only if MURK_HAS(size, murk_medium_data, stratify_flights)):
+    /* ABI 1.5 (read it only if MURK_HAS(size, murk_medium_data, stratify_flights)):
      * the medium's `stratify_flights` key. 1: the integrator has sought (murk_sample_seek) to this flight's
      * own sampler slot before sample(), and the tracker takes the flight's FIRST random numbers from it
      * (with render.sampler sobol a 2-D point stratified over a pixel's samples: the first distance and

@@ -25,7 +25,8 @@
  * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
- * host's sample_light_with / light_pdf_with. Anything else — a changed signature,
+ * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h).
+ * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
  * Contracts common to every kind:
@@ -56,7 +57,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 4
+#define MURK_ABI_MINOR 5
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
