@@ -136,7 +136,7 @@ def main():
                 "render.resolution=[%s,%s]" % (w, h), "--threads", str(threads)]
 
     def mpi(n, threads, out):
-        return ["mpirun", "--oversubscribe", "-x", "MURK_MPI_STATS", "-n", str(n)] + murk(out, threads)
+        return ["mpirun", "--oversubscribe", "--bind-to", "none", "-x", "MURK_MPI_STATS", "-n", str(n)] + murk(out, threads)
 
     configs = [("1x1", 1, 1, murk("t1.exr", 1)), ("1x2", 1, 2, murk("t2.exr", 2)),
                ("mpi 1x2", 1, 2, mpi(1, 2, "m12.exr")), ("mpi 2x1", 2, 1, mpi(2, 1, "m21.exr")),

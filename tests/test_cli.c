@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *const commands[] = {"render", "info", "plugins", "compare", "check", "grid", "help"};
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
@@ -157,6 +158,30 @@ static void test_info(void **state)
     free(err);
 }
 
+/* A process confined to one CPU (as mpirun's default binding confines a rank) and asked for 2 threads
+ * says so; without --threads it takes 1, the CPUs it may run on. taskset is util-linux's. */
+static void test_affinity(void **state)
+{
+    (void)state;
+    if (access("/usr/bin/taskset", X_OK) != 0)
+        skip();
+    const char *scene = write_tmp("aff.yaml", "murk: 1\n"
+                                              "render: { resolution: [8, 8], spp: 1 }\n"
+                                              "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 30 }\n");
+    const char *murk = getenv("MURK_EXE") ? getenv("MURK_EXE") : "build/core/murk";
+    char *log = NULL;
+    const char *const two[] = {"/usr/bin/taskset", "-c", "0", murk, "render", scene, "-o", tmp_path("aff.exr"),
+                               "--threads", "2", NULL};
+    assert_int_equal(run_argv(&log, two), 0);
+    assert_contains(log, "2 render threads, but this process may run on 1 CPU only (its CPU affinity; under "
+                         "mpirun: --bind-to none)");
+    free(log);
+    const char *const dflt[] = {"/usr/bin/taskset", "-c", "0", murk, "render", scene, "-o", tmp_path("aff.exr"), NULL};
+    assert_int_equal(run_argv(&log, dflt), 0);
+    assert_true(strstr(log, "render threads, but") == NULL);
+    free(log);
+}
+
 int main(void)
 {
     unsetenv("MURK_PLUGIN_PATH");
@@ -164,6 +189,7 @@ int main(void)
         cmocka_unit_test(test_help_everywhere),
         cmocka_unit_test(test_unknown_options),
         cmocka_unit_test(test_info),
+        cmocka_unit_test(test_affinity),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -734,8 +734,8 @@ static int write_meta(const bench *b, const reference *r, int argc, char **argv,
     json_str(f, cmd);
     fprintf(f, ",\n  \"version\": \"%s\",\n  \"scene\": ", MURK_VERSION);
     json_str(f, b->scene);
-    fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %ld,\n", b->time_mode ? "seconds" : "spp",
-            b->repeat, b->threads, sysconf(_SC_NPROCESSORS_ONLN));
+    fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %d,\n", b->time_mode ? "seconds" : "spp",
+            b->repeat, b->threads, murk_cpus_usable());
     fprintf(f, "  \"reference\": {\"path\": ");
     json_str(f, b->reference ? b->reference : r->path);
     fprintf(f, ", \"given\": %s, \"reused\": %s, \"spp\": %d, \"seconds\": %.3f, \"noise_estimated\": %s, \"sets\": [",

@@ -515,9 +515,14 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     err[0] = 0;
     memset(out, 0, sizeof *out);
     int spp = opts->spp > 0 ? opts->spp : s->spp;
-    int nthreads = opts->threads > 0 ? opts->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
+    int usable = murk_cpus_usable();
+    int nthreads = opts->threads > 0 ? opts->threads : usable;
     if (nthreads < 1)
         nthreads = 1;
+    if (nthreads > usable)
+        murk_log(MURK_LOG_INFO, "%d render threads, but this process may run on %d CPU%s only (its CPU affinity; "
+                 "under mpirun: --bind-to none): the threads share %s", nthreads, usable, usable == 1 ? "" : "s",
+                 usable == 1 ? "it" : "them");
     size_t npix = (size_t)s->width * (size_t)s->height;
     job j;
     memset(&j, 0, sizeof j);
