@@ -1,29 +1,44 @@
 /* test_flight_choice.c — what test_flight.c's checks did not see of stratified free flights
- * (murk/tracking.h: murk_flight_float, murk_flight_choice, murk_collisions_choice), for every tracker
- * in plugins/media/, each driven through its sample() with render.sampler sobol and one flight slot
- * over a pixel's first 2^k samples, as the path tracer calls it.
+ * (murk/tracking.h: murk_flight_float, murk_flight_choice, murk_collisions_choice): the choice at a
+ * flight's FIRST collision, and the first flight's distance in heterogeneous media. Every tracker in
+ * plugins/media/ is driven through its sample() as the path tracer calls it: render.sampler sobol, the
+ * rng sought to one flight slot, over a pixel's first 2^k samples.
  *
- *   first choice  a constant grey medium at majorant_factor 1.5: the first tentative collision lies
- *                 where the slot's first coordinate puts it, and is real with probability q = 2/3
- *                 (spectral: absorbed with 1/6). The slot's second coordinate is one per interval of
- *                 2^-k, and every tracker maps the choice's number to its branches in order, so over
- *                 2^k samples the count of first collisions that were real (absorbed) is round(q 2^k)
- *                 within +-1 — a deterministic bound, checked for k = 4..10, 3 pixels x 3 slots.
- *                 A tracker that draws that choice from the PCG stream (murk_rng_float) gives binomial
- *                 counts instead: the same bound on PCG numbers fails most of the 36 cases (asserted,
- *                 the test's own power check). decomposition with control 0 (its first draw is then
- *                 the residual's, whose first choice is the slot's second coordinate).
- *   cloud         cornell_smoke's procedural cloud (grey, sigma_t 18.5), 3 rays through it: the
- *                 distance T of each flight's first real collision has the closed form
- *                 P(T > t) = exp(-sigma_t D(t)) (D: the density's integral along the ray, by
- *                 quadrature), so Y = 1 - exp(-sigma_t D(T)) (1 - exp(-sigma_t D(tmax)) for a flight
- *                 that passes) has mean Ymax - Ymax^2 / 2. Per tracker and ray, 64 pixels (independent
- *                 scrambles) x 1024 stratified samples: the mean of Y over all of them within 4 se of
- *                 that, se from the spread of the 64 pixel means (they are independent, the samples
- *                 within a pixel are not). Stratification makes that se small enough to see a first
- *                 flight 5% short (murk_flight_exp or murk_collisions_next scaled by 0.95), which the
- *                 image test of test_flight.c does not; the same figure with render.sampler
- *                 independent is printed beside it. */
+ *   first choice    a constant grey medium at majorant_factor 1.5: the first tentative collision lies
+ *                   where the slot's first coordinate puts it (no flight may end before it) and is
+ *                   real with probability q = 2/3 (spectral: absorbed with 1/6). The slot's second
+ *                   coordinate is one per interval of 2^-k and every tracker takes a branch when that
+ *                   number is below the branch's cumulative probability (a prefix [0, p)), so over 2^k
+ *                   samples the count of first collisions that were real (absorbed) is round(p 2^k)
+ *                   within +-1: a deterministic bound, for k = 4, 6, 8, 10 x 3 pixels x 3 slots. A
+ *                   tracker that draws that choice from the PCG stream (murk_rng_float) gives binomial
+ *                   counts instead; the same counts made from PCG numbers here must fail the bound in
+ *                   at least half the 36 cases (the test's own power check: 21 fail). With
+ *                   murk_rng_float in place of murk_collisions_choice / murk_flight_choice each tracker
+ *                   failed 21 of the 36 cases (spectral 33). decomposition with control 0: its first
+ *                   draw is then the residual's, whose choice is the slot's.
+ *   first distance  three grey heterogeneous media — cornell_smoke's procedural cloud (sigma_t 18.5,
+ *                   majorant cells mostly above the density: the first flight crosses cells and meets
+ *                   null collisions), a dense smooth grid (0.6 .. 1.4, where decomposition's first draw
+ *                   is its first cell's control distance) and test_media.c's plateau (constant cells
+ *                   first: spectral_mis closed_form takes them) — 3 rays each. The distance T of a
+ *                   flight's first real collision has the closed form P(T > t) = exp(-sigma_t D(t))
+ *                   (D: the density's integral along the ray, by quadrature), so
+ *                   Y = 1 - exp(-sigma_t D(T)) (1 - exp(-sigma_t D(tmax)) if the flight passes) is
+ *                   min(V, Ymax) with V uniform: mean Ymax - Ymax^2 / 2 and P(Y < c) = c. Per tracker,
+ *                   medium and ray, 128 pixels (independent scrambles) x 1024 samples, with sobol and
+ *                   with independent numbers: those five statistics within 5 se of the closed form, the
+ *                   se from the spread of the 128 pixel means (the samples within a pixel are not
+ *                   independent), at least one sample's worth (1 / 131072: where the first coordinate
+ *                   alone decides, the pixel counts are exact and the spread is 0). Stratification
+ *                   makes the se small enough to see a first flight 5% short, which test_flight.c's
+ *                   images do not on the cloud: with the stratified first draw x 0.95 in
+ *                   murk_collisions_next, the trackers that use it failed with max |z| 7-14 per ray on
+ *                   the cloud, 95-111 on the grid, 390-540 on the plateau; in murk_flight_exp,
+ *                   decomposition 8-22 on the grid, 80-170 on the plateau (on the cloud its slot only
+ *                   draws the first residual distance in the first non-empty cell: |z| < 1.4); in
+ *                   spectral_mis's closed form, closed_form: true 100-470 on the plateau. Every other
+ *                   figure stayed within |z| 2.4. */
 #include "testutil.h"
 #include "mediatest.h"
 
@@ -206,7 +221,7 @@ static void flight_stats(const murk_medium *m, const murk_ray *ray, const double
     }
     for (int j = 0; j < NSTATS; j++) {
         double dm = s[j] / npix, se = sqrt(fmax(0.0, (s2[j] - npix * dm * dm) / (npix - 1.0)) / npix);
-        z[j] = se > 0.0 ? dm / se : (dm == 0.0 ? 0.0 : INFINITY);
+        z[j] = dm / fmax(se, 1.0 / ((double)npix * n));
         if (j == 0)
             *se_mean = se;
     }
@@ -220,12 +235,25 @@ static float dense_f(int x, int y, int z, float cx, float cy, float cz)
     return 1.0f + 0.4f * sinf(5.0f * cx + 1.0f) * sinf(4.0f * cy + 0.3f) * cosf(3.0f * cz);
 }
 
+/* test_media.c's plateau: 0.8 for z < 0.5, rising to 2.3 at z = 1 (4x4x16 voxels on [0,1]^3): constant
+ * majorant cells first, where spectral_mis's closed_form takes the flight, varying ones after. */
+static float plateau_f(int x, int y, int z, float cx, float cy, float cz)
+{
+    (void)x, (void)y, (void)z, (void)cx, (void)cy;
+    return cz < 0.5f ? 0.8f : 0.8f + 3.0f * (cz - 0.5f);
+}
+
+#define NCONFIGS (NTRACKERS + 1)
+
 static void test_first_distance(void **state)
 {
     (void)state;
-    char grid[512];
+    char grid[512], plateau[512];
     snprintf(grid, sizeof grid, "density: { grid: '%s' }, scale: 3, %s",
              mt_save_grid("dense.vol", (int[]){16, 16, 16}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), dense_f), MT_GREY_KEYS);
+    snprintf(plateau, sizeof plateau, "density: { grid: '%s' }, scale: 3, %s",
+             mt_save_grid("plateau.vol", (int[]){4, 4, 16}, murk_v3(0, 0, 0), murk_v3(1, 1, 1), plateau_f),
+             MT_GREY_KEYS);
     const struct {
         const char *name, *common;
         double sigma_t;
@@ -245,26 +273,32 @@ static void test_first_distance(void **state)
          {{{0.0f, 0.4f, 0.6f}, {1, 0, 0}, 0.0f, 1.5f},
           {{0.0f, 0.1f, 0.2f}, {0.7071068f, 0.5f, 0.5f}, 0.0f, 1.5f},
           {{0.3f, 0.0f, 0.7f}, {0, 1, 0}, 0.0f, 1.5f}}},
+        /* the plateau from below it, slanted (test_media.c's ramp ray) and from inside it */
+        {"plateau", plateau, 3.0 * mt_sigma_t[0][0],
+         {{{0.5f, 0.5f, -0.2f}, {0, 0, 1}, 0.0f, 1.5f},
+          {{0.3f, 0.4f, -0.5f}, {0.1951800f, 0.0975900f, 0.9759001f}, 0.0f, 2.5f},
+          {{0.1f, 0.2f, 0.1f}, {0.5050763f, 0.3030458f, 0.8081220f}, 0.0f, 1.5f}}},
     };
-    mt_spec ms[NTRACKERS];
-    char keys[NTRACKERS][64];
+    mt_spec ms[NCONFIGS];
+    char keys[NCONFIGS][64];
     for (int i = 0; i < NTRACKERS; i++) {
         snprintf(keys[i], sizeof keys[i], "type: %s", TRACKERS[i]);
         ms[i] = (mt_spec){TRACKERS[i], keys[i], 0};
     }
+    ms[NTRACKERS] = (mt_spec){"spectral_mis_cf", "type: spectral_mis, closed_form: true", 0};
     double *D = malloc((NBINS + 1) * sizeof *D);
     assert_non_null(D);
     int nbad = 0;
     for (size_t md = 0; md < sizeof media / sizeof media[0]; md++) {
-        murk_scene *s = mt_load_media("first.yaml", media[md].common, "", ms, NTRACKERS);
+        murk_scene *s = mt_load_media("first.yaml", media[md].common, "", ms, NCONFIGS);
         for (int r = 0; r < 3; r++) {
             const murk_ray *ray = &media[md].rays[r];
-            mt_depths(&s->media[0].m, NULL, ray, NBINS, 4, D);
+            mt_depths(&s->media[0].m, NULL, ray, NBINS, 64, D);
             printf("%s, ray %d (optical depth %.2f): z of Y's", media[md].name, r, media[md].sigma_t * D[NBINS]);
             for (int j = 0; j < NSTATS; j++)
                 printf(" %s", STAT_NAMES[j]);
             printf(" (sobol | independent)\n");
-            for (int i = 0; i < NTRACKERS; i++) {
+            for (int i = 0; i < NCONFIGS; i++) {
                 double z[2][NSTATS], se[2];
                 int bad = 0;
                 for (int smp = 0; smp < 2; smp++) {
@@ -274,7 +308,7 @@ static void test_first_distance(void **state)
                     for (int j = 0; j < NSTATS; j++)
                         bad |= !(fabs(z[smp][j]) <= ZMAX);
                 }
-                printf("  %-15s", TRACKERS[i]);
+                printf("  %-15s", ms[i].label);
                 for (int smp = 0; smp < 2; smp++) {
                     for (int j = 0; j < NSTATS; j++)
                         printf(" %+6.2f", z[smp][j]);
