@@ -1,13 +1,14 @@
 /* test_mpi.c — `mpirun -n N murk render` (issue 13, items 1 and 5). A scene with a medium rendered by 1, 2
- * and 3 ranks is bitwise the single-process render, with the same rays and cost counters (summed over
- * the ranks); so are a render resumed by 3 ranks from the checkpoint 2 ranks wrote, and a --time render
- * (rank 0 decides the passes) against a single-process render of the spp it reached, and a --part
- * rendered by 2 ranks. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the job with
- * the located message naming that rank, a non-zero status and no image; so does a rank given other
- * options than rank 0. A rank other than 0 holds the tiles it renders, not the image: its peak resident
- * memory (MURK_MPI_STATS) grows by less than 2 bytes per pixel from a 64x64 to a 2048x2048 image.
- * Skipped (exit 77) when murk is built without MPI or mpirun is missing. The ranks run on this machine,
- * oversubscribed (--oversubscribe), as root when need be (OMPI_ALLOW_RUN_AS_ROOT). */
+ * and 3 ranks (and 2 ranks of 2 threads) is bitwise the single-process render, with the same rays and
+ * cost counters (summed over the ranks); so are a render resumed by 3 ranks from the checkpoint 2 ranks
+ * wrote, and a --time render (rank 0 decides the passes) against a single-process render of the spp it
+ * reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over
+ * MURK_MAX_GRID_VOXELS) stops the job with the located message naming that rank, a non-zero status and
+ * no image; so does a rank given other options than rank 0. A rank other than 0 holds the tiles it
+ * renders, not the image: its peak resident memory (MURK_MPI_STATS) grows by less than 2 bytes per
+ * pixel from a 64x64 to a 2048x2048 image. Skipped (exit 77) when murk is built without MPI or mpirun is
+ * missing. The ranks run on this machine, oversubscribed (--oversubscribe), as root when need be
+ * (OMPI_ALLOW_RUN_AS_ROOT). */
 #include "image.h"
 #include "testutil.h"
 
@@ -80,6 +81,15 @@ static void ranks_give_the_single_process_image(void **state)
         snprintf(counters, sizeof counters, "%s", meta(tmp_path("single.exr"), "murk:counters"));
         assert_string_equal(meta(tmp_path(out), "murk:counters"), counters);
     }
+    /* 2 ranks of 2 threads: rank 1 renders 2 tiles at once, in 2 of its 3 slots */
+    char *log = NULL;
+    const char *extra[] = {"--spp", SPP, "--threads", "2", NULL};
+    int rc = mpi_render(&log, 2, "threads2.exr", extra);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 murk render --threads 2 failed (%d):\n%s", rc, log);
+    free(log);
+    assert_same_pixels(tmp_path("threads2.exr"), tmp_path("single.exr"));
+    assert_string_equal(meta(tmp_path("threads2.exr"), "murk:threads"), "4");
 }
 
 static void resumed_by_other_ranks(void **state)

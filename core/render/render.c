@@ -380,6 +380,11 @@ static void work_pass(job *j, int ask)
                 murk_mpi_recv(0, tag, &end, sizeof end);
                 continue;
             }
+            if (nfree == 0) { /* rank 0 sent more tiles than were asked for: never, by the protocol */
+                fprintf(stderr, "murk: rank %d (%s): a tile beyond the %d asked for\n", murk_mpi_rank(),
+                        murk_mpi_host(), ask);
+                murk_mpi_abort(1);
+            }
             unsigned char *msg = j->held[k = freed[--nfree]];
             murk_mpi_recv(0, tag, msg, n > HDR_BYTES + TILE_BYTES ? HDR_BYTES + TILE_BYTES : n);
             int32_t hdr[4];
