@@ -1,12 +1,14 @@
 /* test_mpi.c — `mpirun -n N murk render` (issue 13, items 1 and 5). A scene with a medium rendered by 1, 2
- * and 3 ranks is bitwise the single-process render, with the same rays and cost counters (summed over
- * the ranks); so are a render resumed by 3 ranks from the
- * checkpoint 2 ranks wrote, and a --time render (rank 0 decides the passes) against a single-process
- * render of the spp it reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over MURK_MAX_GRID_VOXELS) stops the
- * job with the located message naming that rank, a non-zero status and no image; so does a rank given
- * other options than rank 0. Skipped (exit 77)
- * when murk is built without MPI or mpirun is missing. The ranks run on this machine, oversubscribed
- * (--oversubscribe), as root when need be (OMPI_ALLOW_RUN_AS_ROOT). */
+ * and 3 ranks (and 2 ranks of 2 threads) is bitwise the single-process render, with the same rays and
+ * cost counters (summed over the ranks); so are a render resumed by 3 ranks from the checkpoint 2 ranks
+ * wrote, and a --time render (rank 0 decides the passes) against a single-process render of the spp it
+ * reached, and a --part rendered by 2 ranks. An error on one rank only (its grid over
+ * MURK_MAX_GRID_VOXELS) stops the job with the located message naming that rank, a non-zero status and
+ * no image; so does a rank given other options than rank 0. A rank other than 0 holds the tiles it
+ * renders, not the image: its peak resident memory (MURK_MPI_STATS) grows by less than 2 bytes per
+ * pixel from a 64x64 to a 2048x2048 image. Skipped (exit 77) when murk is built without MPI or mpirun is
+ * missing. The ranks run on this machine, oversubscribed (--oversubscribe), as root when need be
+ * (OMPI_ALLOW_RUN_AS_ROOT). */
 #include "image.h"
 #include "testutil.h"
 
@@ -79,6 +81,15 @@ static void ranks_give_the_single_process_image(void **state)
         snprintf(counters, sizeof counters, "%s", meta(tmp_path("single.exr"), "murk:counters"));
         assert_string_equal(meta(tmp_path(out), "murk:counters"), counters);
     }
+    /* 2 ranks of 2 threads: rank 1 renders 2 tiles at once, in 2 of its 3 slots */
+    char *log = NULL;
+    const char *extra[] = {"--spp", SPP, "--threads", "2", NULL};
+    int rc = mpi_render(&log, 2, "threads2.exr", extra);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 murk render --threads 2 failed (%d):\n%s", rc, log);
+    free(log);
+    assert_same_pixels(tmp_path("threads2.exr"), tmp_path("single.exr"));
+    assert_string_equal(meta(tmp_path("threads2.exr"), "murk:threads"), "4");
 }
 
 static void resumed_by_other_ranks(void **state)
@@ -131,6 +142,45 @@ static void part_rendered_by_ranks(void **state)
     free(log);
     assert_same_pixels(tmp_path("part1_mpi.exr"), tmp_path("part1.exr"));
     assert_string_equal(meta(tmp_path("part1_mpi.exr"), "murk:part"), "1/3");
+}
+
+/* Rank 1's peak resident memory in kB (VmHWM, which MURK_MPI_STATS=1 makes it print) over a render of
+ * the Cornell box at res x res, 1 spp, one bounce, by 2 ranks of one thread. */
+static long rank1_peak_kb(int res)
+{
+    char set[64], *log = NULL;
+    snprintf(set, sizeof set, "render.resolution=[%d,%d]", res, res);
+    const char *argv[] = {getenv("MURK_MPIRUN"), "--oversubscribe", "-n", "2", "-x", "MURK_MPI_STATS=1",
+                          getenv("MURK_EXE"), "render", src_path("scenes/cornell.yaml"), "-o", tmp_path("big.exr"),
+                          "--set", set, "--set", "integrator.max_depth=1", "--spp", "1", "--threads", "1", "--quiet",
+                          NULL};
+    int rc = run_argv(&log, argv);
+    if (rc != 0)
+        fail_msg("mpirun -n 2 murk render at %dx%d failed (%d):\n%s", res, res, rc, log);
+    const char *at = strstr(log, "murk: mpi: rank 1: peak resident memory ");
+    long kb = at ? atol(at + strlen("murk: mpi: rank 1: peak resident memory ")) : -1;
+    if (kb <= 0)
+        fail_msg("no peak resident memory of rank 1 in:\n%s", log);
+    free(log);
+    remove(tmp_path("big.exr"));
+    remove(tmp_path("big.png"));
+    return kb;
+}
+
+/* Rank 1 holds at most --threads + 1 = 2 tiles (16 + 16 x 16 x 28 bytes = 7 KB each) and as many results
+ * on their way back: 29 KB whatever the image. The bound, 2 bytes per pixel (8 MB at 2048x2048), leaves
+ * room for the allocator and Open MPI and is below any per-pixel array (a uint32 count alone is 4 B
+ * per pixel): the code that held the image's sums and counts on every rank (28 B per pixel, 117 MB)
+ * grew by 112 MB here. */
+static void worker_rank_memory_follows_its_tiles(void **state)
+{
+    (void)state;
+    long small = rank1_peak_kb(64), big = rank1_peak_kb(2048), bound = 2L * 2048 * 2048 / 1024;
+    print_message("rank 1 peak resident memory: %ld kB at 64x64, %ld kB at 2048x2048 (bound: +%ld kB)\n", small,
+                  big, bound);
+    if (big - small >= bound)
+        fail_msg("rank 1 grew by %ld kB from 64x64 to 2048x2048, not less than %ld kB: it holds more than its tiles",
+                 big - small, bound);
 }
 
 static void error_on_one_rank_stops_the_job(void **state)
@@ -189,6 +239,7 @@ int main(void)
         cmocka_unit_test(time_limit_passes_are_rank0s),
         cmocka_unit_test(part_rendered_by_ranks),
         cmocka_unit_test(error_on_one_rank_stops_the_job),
+        cmocka_unit_test(worker_rank_memory_follows_its_tiles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

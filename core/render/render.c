@@ -11,7 +11,9 @@
  * counts (none in a render's first pass) and comes back with them advanced by the pass's samples in
  * sample order: no pixel is ever summed across ranks, so the sums are the single-process ones bit for
  * bit. Messages per tile and pass: one TILE (16 bytes + 28 per pixel of state) and one RESULT (8 + 28
- * per pixel). After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
+ * per pixel). The other ranks never hold the image: their render threads advance a tile's state in the
+ * TILE message it came in (a held tile), so a rank's memory is its threads + 1 tiles of 7 KB whatever
+ * the image's size. After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
 #include "camera.h"
 #include "checkpoint.h"
 #include "error.h"
@@ -36,13 +38,13 @@
 
 enum { TILE = 16 };
 
-/* Tile numbers handed between a rank's main thread and its render threads (MPI ranks other than 0):
- * each tile enters at most once per pass, so ntiles slots never overflow. */
+/* Slots of held tiles (take_tile) handed between a rank's main thread and its render threads (MPI ranks
+ * other than 0): a ring of cap entries, as many as the rank holds tiles at most, so it never overflows. */
 typedef struct tile_queue {
     pthread_mutex_t mu;
     pthread_cond_t cv;
     int *t;
-    int head, tail, closed;
+    int cap, head, tail, closed;
 } tile_queue;
 
 typedef struct job {
@@ -61,7 +63,8 @@ typedef struct job {
     size_t nslots;
     murk_counters media[MURK_COUNTER_SLOTS];
     double max_sample; /* the largest channel of a finite sample */
-    tile_queue *inq, *outq; /* MPI ranks other than 0: tiles to render, tiles rendered */
+    tile_queue *inq, *outq; /* MPI ranks other than 0: slots of tiles to render, of tiles rendered */
+    unsigned char **held;   /* MPI ranks other than 0: the held tiles' TILE messages by slot */
     /* rank 0 under MPI (MURK_MPI_STATS=1 prints them): tiles handed to other ranks, messages and bytes
      * received and sent, seconds its main thread spent handling them, passes */
     uint64_t mpi_tiles, mpi_msgs, mpi_bytes, mpi_passes;
@@ -74,7 +77,8 @@ static void queue_init(tile_queue *q, int n)
 {
     pthread_mutex_init(&q->mu, NULL);
     pthread_cond_init(&q->cv, NULL);
-    q->t = murk_xmalloc((size_t)(n > 0 ? n : 1) * sizeof *q->t);
+    q->cap = n > 0 ? n : 1;
+    q->t = murk_xmalloc((size_t)q->cap * sizeof *q->t);
     q->head = q->tail = q->closed = 0;
 }
 
@@ -88,7 +92,7 @@ static void queue_free(tile_queue *q)
 static void queue_push(tile_queue *q, int t)
 {
     pthread_mutex_lock(&q->mu);
-    q->t[q->tail++] = t;
+    q->t[q->tail++ % q->cap] = t;
     pthread_cond_signal(&q->cv);
     pthread_mutex_unlock(&q->mu);
 }
@@ -99,7 +103,7 @@ static int queue_pop(tile_queue *q, int wait)
     pthread_mutex_lock(&q->mu);
     while (wait && q->head == q->tail && !q->closed)
         pthread_cond_wait(&q->cv, &q->mu);
-    int t = q->head < q->tail ? q->t[q->head++] : -1;
+    int t = q->head < q->tail ? q->t[q->head++ % q->cap] : -1;
     pthread_mutex_unlock(&q->mu);
     return t;
 }
@@ -112,20 +116,37 @@ static void queue_close(tile_queue *q)
     pthread_mutex_unlock(&q->mu);
 }
 
-/* The next tile of this pass for a render thread, or -1 when there is none. */
-static int take_tile(job *j)
+/* A held tile: a rank other than 0 keeps the TILE message a tile came in until its RESULT goes back:
+ * a 16-byte header (int32 tile number, has state, 0, 0), then for its n pixels, row by row, n x 3 double
+ * sums and n uint32 counts. The render threads advance the state there, so a rank other than 0 holds
+ * tiles only, never the image. */
+enum { HDR_BYTES = 16 };
+
+/* The sums and counts of a held tile of n pixels, p pointing past its header. */
+static double *state_sum(unsigned char *p) { return (double *)(void *)p; }
+static uint32_t *state_count(unsigned char *p, size_t n) { return (uint32_t *)(void *)(p + 3 * n * sizeof(double)); }
+
+/* The next tile of this pass for a render thread, or -1 when there is none; *slot is its held tile's slot
+ * (MPI ranks other than 0) or -1 (its state is in the image's j->sum and j->count). */
+static int take_tile(job *j, int *slot)
 {
-    if (j->inq)
-        return queue_pop(j->inq, 1);
+    *slot = -1;
+    if (j->inq) {
+        int32_t t;
+        if ((*slot = queue_pop(j->inq, 1)) < 0)
+            return -1;
+        memcpy(&t, j->held[*slot], sizeof t);
+        return t;
+    }
     int k = atomic_fetch_add(&j->next, 1);
     return k < j->ntiles ? j->tiles[k] : -1;
 }
 
-static void tile_done(job *j, int t, double seconds)
+static void tile_done(job *j, int slot, double seconds)
 {
     atomic_fetch_add(&j->busy_ns, (uint64_t)(seconds * 1e9));
     if (j->outq)
-        queue_push(j->outq, t);
+        queue_push(j->outq, slot);
     atomic_fetch_add(&j->done, 1);
 }
 
@@ -146,17 +167,26 @@ static void *worker(void *arg)
                 atomic_store(&j->abandoned, 1);
             break;
         }
-        int t = take_tile(j);
+        int slot, t = take_tile(j, &slot);
         if (t < 0)
             break;
         double t_tile = murk_now();
         int x0 = (t % j->tiles_x) * TILE, y0 = (t / j->tiles_x) * TILE;
         int x1 = x0 + TILE < s->width ? x0 + TILE : s->width, y1 = y0 + TILE < s->height ? y0 + TILE : s->height;
+        /* the state of pixel (x, y) is sum[3 * at], count[at]: at is its index in the image or in the tile */
+        double *sum = j->sum;
+        uint32_t *count = j->count;
+        size_t stride = (size_t)s->width, ox = 0, oy = 0;
+        if (slot >= 0) {
+            stride = (size_t)(x1 - x0), ox = (size_t)x0, oy = (size_t)y0;
+            sum = state_sum(j->held[slot] + HDR_BYTES);
+            count = state_count(j->held[slot] + HDR_BYTES, stride * (size_t)(y1 - y0));
+        }
         for (int y = y0; y < y1; y++)
             for (int x = x0; x < x1; x++) {
-                size_t pix = (size_t)y * (size_t)s->width + (size_t)x;
-                double acc[3] = {j->sum[3 * pix], j->sum[3 * pix + 1], j->sum[3 * pix + 2]};
-                uint32_t n = j->count[pix];
+                size_t pix = (size_t)y * (size_t)s->width + (size_t)x, at = ((size_t)y - oy) * stride + (size_t)x - ox;
+                double acc[3] = {sum[3 * at], sum[3 * at + 1], sum[3 * at + 2]};
+                uint32_t n = count[at];
                 for (int k = j->spp0; k < j->spp1; k++) {
                     murk_rng rng;
                     murk_ray r;
@@ -173,10 +203,10 @@ static void *worker(void *arg)
                         peak = fabsf(L.c[c]) > peak ? fabsf(L.c[c]) : peak;
                     n++;
                 }
-                j->sum[3 * pix] = acc[0], j->sum[3 * pix + 1] = acc[1], j->sum[3 * pix + 2] = acc[2];
-                j->count[pix] = n;
+                sum[3 * at] = acc[0], sum[3 * at + 1] = acc[1], sum[3 * at + 2] = acc[2];
+                count[at] = n;
             }
-        tile_done(j, t, murk_now() - t_tile);
+        tile_done(j, slot, murk_now() - t_tile);
     }
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
@@ -213,24 +243,24 @@ static void tile_rect(const job *j, int t, int *x0, int *y0, int *x1, int *y1)
 /* Bytes of a tile's state: 3 double sums and a uint32 count per pixel. */
 enum { PIX_BYTES = 3 * sizeof(double) + sizeof(uint32_t), TILE_BYTES = TILE * TILE * PIX_BYTES };
 
-/* Copies tile t's state to (dir > 0) or from (dir < 0) the buffer p, or clears it (dir == 0). */
+/* Rank 0: copies tile t's state from the image to (dir > 0) or from (dir < 0) the message bytes p, laid
+ * out as a held tile's. */
 static void tile_state(job *j, int t, unsigned char *p, int dir)
 {
     int x0, y0, x1, y1;
     tile_rect(j, t, &x0, &y0, &x1, &y1);
+    size_t w = (size_t)(x1 - x0), n = w * (size_t)(y1 - y0);
+    unsigned char *sums = p, *counts = p + 3 * n * sizeof(double);
     for (int y = y0; y < y1; y++) {
-        size_t pix = (size_t)y * (size_t)j->s->width + (size_t)x0, n = (size_t)(x1 - x0);
-        double *sum = j->sum + 3 * pix;
-        uint32_t *count = j->count + pix;
+        size_t pix = (size_t)y * (size_t)j->s->width + (size_t)x0, row = (size_t)(y - y0) * w;
+        unsigned char *sum = (unsigned char *)(j->sum + 3 * pix), *count = (unsigned char *)(j->count + pix);
+        unsigned char *msum = sums + 3 * row * sizeof(double), *mcount = counts + row * sizeof(uint32_t);
         if (dir > 0) {
-            memcpy(p, sum, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
-            memcpy(p, count, n * sizeof *count), p += n * sizeof *count;
-        } else if (dir < 0) {
-            memcpy(sum, p, 3 * n * sizeof *sum), p += 3 * n * sizeof *sum;
-            memcpy(count, p, n * sizeof *count), p += n * sizeof *count;
+            memcpy(msum, sum, 3 * w * sizeof(double));
+            memcpy(mcount, count, w * sizeof(uint32_t));
         } else {
-            memset(sum, 0, 3 * n * sizeof *sum);
-            memset(count, 0, n * sizeof *count);
+            memcpy(sum, msum, 3 * w * sizeof(double));
+            memcpy(count, mcount, w * sizeof(uint32_t));
         }
     }
 }
@@ -248,12 +278,12 @@ static void hand_out(job *j, int to, int stopped, int *remote)
         return;
     }
     int t = j->tiles[k], state = j->spp0 > 0;
-    size_t n = 16 + (state ? TILE_BYTES : 0);
+    size_t n = HDR_BYTES + (state ? TILE_BYTES : 0);
     unsigned char *msg = murk_xmalloc(n);
     int32_t hdr[4] = {t, state, 0, 0};
     memcpy(msg, hdr, sizeof hdr);
     if (state)
-        tile_state(j, t, msg + 16, 1);
+        tile_state(j, t, msg + HDR_BYTES, 1);
     murk_mpi_post(to, MURK_TAG_TILE, msg, n);
     (*remote)++;
     j->mpi_tiles++;
@@ -279,7 +309,7 @@ static void nap(void)
 static void serve_pass(job *j, int progress, double t_start, int spp_total, int spp_before)
 {
     int waiting = murk_mpi_size() - 1, remote = 0, stopped = 0;
-    size_t cap = 16 + TILE_BYTES;
+    size_t cap = HDR_BYTES + TILE_BYTES;
     unsigned char *buf = murk_xmalloc(cap);
     double drawn = 0;
     for (;;) {
@@ -327,38 +357,53 @@ static void serve_pass(job *j, int progress, double t_start, int spp_total, int 
     murk_mpi_flush();
 }
 
-/* The main thread of a rank other than 0 during a pass: asks for `ask` tiles, queues the tiles that
- * come for its render threads, returns each rendered tile (which asks for the next) and returns when
- * every request has been answered and every tile it got is back. */
+/* The main thread of a rank other than 0 during a pass: asks for `ask` tiles, receives each tile that
+ * comes into a free held tile's slot (there is one: a rank holds at most as many tiles as it asked for)
+ * and queues it for its render threads, returns each rendered tile (which asks for the next) and
+ * returns when every request has been answered and every tile it got is back. */
 static void work_pass(job *j, int ask)
 {
     int32_t *req = murk_xmalloc(sizeof *req);
     *req = ask;
     murk_mpi_post(0, MURK_TAG_REQ, req, sizeof *req);
-    int asked = ask, held = 0;
-    unsigned char *buf = murk_xmalloc(16 + TILE_BYTES);
+    int asked = ask, held = 0, nfree = ask, *freed = murk_xmalloc((size_t)ask * sizeof *freed);
+    for (int k = 0; k < ask; k++)
+        freed[k] = k;
     for (;;) {
-        int from, tag, t, busy = 0;
+        int from, tag, k, busy = 0;
         size_t n;
         while (murk_mpi_poll(0, &from, &tag, &n)) {
             busy = 1;
-            murk_mpi_recv(0, tag, buf, n > 16 + TILE_BYTES ? 16 + TILE_BYTES : n);
             asked--;
-            if (tag == MURK_TAG_TILE) {
-                int32_t hdr[4];
-                memcpy(hdr, buf, sizeof hdr);
-                tile_state(j, hdr[0], buf + 16, hdr[1] ? -1 : 0);
-                held++;
-                queue_push(j->inq, hdr[0]);
+            if (tag != MURK_TAG_TILE) { /* END */
+                int32_t end;
+                murk_mpi_recv(0, tag, &end, sizeof end);
+                continue;
             }
+            if (nfree == 0) { /* rank 0 sent more tiles than were asked for: never, by the protocol */
+                fprintf(stderr, "murk: rank %d (%s): a tile beyond the %d asked for\n", murk_mpi_rank(),
+                        murk_mpi_host(), ask);
+                murk_mpi_abort(1);
+            }
+            unsigned char *msg = j->held[k = freed[--nfree]];
+            murk_mpi_recv(0, tag, msg, n > HDR_BYTES + TILE_BYTES ? HDR_BYTES + TILE_BYTES : n);
+            int32_t hdr[4];
+            memcpy(hdr, msg, sizeof hdr);
+            if (!hdr[1]) /* a render's first pass: no state yet */
+                memset(msg + HDR_BYTES, 0, TILE_BYTES);
+            held++;
+            queue_push(j->inq, k);
         }
-        while ((t = queue_pop(j->outq, 0)) >= 0) {
+        while ((k = queue_pop(j->outq, 0)) >= 0) {
             busy = 1;
             unsigned char *msg = murk_xmalloc(8 + TILE_BYTES);
-            int32_t hdr[2] = {t, 0};
+            int32_t hdr[2];
+            memcpy(hdr, j->held[k], sizeof hdr[0]);
+            hdr[1] = 0;
             memcpy(msg, hdr, sizeof hdr);
-            tile_state(j, t, msg + 8, 1);
+            memcpy(msg + 8, j->held[k] + HDR_BYTES, TILE_BYTES);
             murk_mpi_post(0, MURK_TAG_RESULT, msg, 8 + TILE_BYTES);
+            freed[nfree++] = k;
             held--;
             asked++;
         }
@@ -367,7 +412,7 @@ static void work_pass(job *j, int ask)
         if (!busy)
             nap();
     }
-    free(buf);
+    free(freed);
     queue_close(j->inq);
     murk_mpi_flush();
 }
@@ -397,7 +442,7 @@ static void run_pass(job *j, int nthreads, int progress, double t_start, int spp
         return;
     }
     if (j->inq)
-        work_pass(j, started + 1);
+        work_pass(j, started + 1); /* at most nthreads + 1: as many as there are slots of held tiles */
     else if (murk_mpi_size() > 1)
         serve_pass(j, progress, t_start, spp_total, spp_before);
     else
@@ -477,12 +522,31 @@ static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
     murk_mpi_max_double(&j->max_sample);
 }
 
-/* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end. */
+/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
+static long peak_rss_kb(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    long kb = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return kb;
+}
+
+/* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end.
+ * Its memory is its nthreads + 1 held tiles' (7 KB each), whatever the image's size. */
 static int follow_passes(job *j, int nthreads, murk_render_result *out)
 {
     tile_queue inq, outq;
-    queue_init(&inq, j->ntiles);
-    queue_init(&outq, j->ntiles);
+    int nheld = nthreads + 1;
+    queue_init(&inq, nheld);
+    queue_init(&outq, nheld);
+    j->held = murk_xmalloc((size_t)nheld * sizeof *j->held);
+    for (int k = 0; k < nheld; k++)
+        j->held[k] = murk_xmalloc(HDR_BYTES + TILE_BYTES); /* zeroed: a RESULT's unused bytes are defined */
     j->inq = &inq, j->outq = &outq, j->stop = NULL;
     pass_msg pm;
     for (;;) {
@@ -499,6 +563,11 @@ static int follow_passes(job *j, int nthreads, murk_render_result *out)
     }
     queue_free(&inq);
     queue_free(&outq);
+    for (int k = 0; k < nheld; k++)
+        free(j->held[k]);
+    free(j->held);
+    if (getenv("MURK_MPI_STATS")) /* what this rank held at most (tests/test_mpi.c) */
+        fprintf(stderr, "murk: mpi: rank %d: peak resident memory %ld kB\n", murk_mpi_rank(), peak_rss_kb());
     if (pm.cmd == PASS_END)
         sum_over_ranks(j, nthreads, out);
     out->spp = pm.spp0;
@@ -527,9 +596,24 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
     job j;
     memset(&j, 0, sizeof j);
     j.s = s;
+    j.tiles_x = (s->width + TILE - 1) / TILE;
+    j.stop = opts->stop;
+    atomic_init(&j.rays, 0);
+    atomic_init(&j.nonfinite, 0);
+    atomic_init(&j.busy_ns, 0);
+    atomic_init(&j.abandoned, 0);
+    pthread_mutex_init(&j.lock, NULL);
+    j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
+    out->width = s->width;
+    out->height = s->height;
+    out->ranks = murk_mpi_size();
+    if (murk_mpi_rank() > 0) { /* it holds the tiles rank 0 hands it, not the image */
+        int rc = follow_passes(&j, nthreads, out);
+        pthread_mutex_destroy(&j.lock);
+        return rc;
+    }
     j.sum = murk_xmalloc(3 * npix * sizeof(double));
     j.count = murk_xmalloc(npix * sizeof(uint32_t));
-    j.tiles_x = (s->width + TILE - 1) / TILE;
     int alltiles = j.tiles_x * ((s->height + TILE - 1) / TILE);
     int *tiles = murk_xmalloc((size_t)alltiles * sizeof *tiles);
     size_t npix_rendered = 0;
@@ -541,24 +625,6 @@ MURK_API int murk_render_err(const murk_scene *s, const murk_render_opts *opts, 
             npix_rendered += (size_t)(x1 - x0) * (size_t)(y1 - y0);
         }
     j.tiles = tiles;
-    j.stop = opts->stop;
-    atomic_init(&j.rays, 0);
-    atomic_init(&j.nonfinite, 0);
-    atomic_init(&j.busy_ns, 0);
-    atomic_init(&j.abandoned, 0);
-    pthread_mutex_init(&j.lock, NULL);
-    j.nslots = s->nmedia < MURK_COUNTER_SLOTS ? s->nmedia : MURK_COUNTER_SLOTS;
-    out->width = s->width;
-    out->height = s->height;
-    out->ranks = murk_mpi_size();
-    if (murk_mpi_rank() > 0) {
-        int rc = follow_passes(&j, nthreads, out);
-        pthread_mutex_destroy(&j.lock);
-        free(j.sum);
-        free(j.count);
-        free(tiles);
-        return rc;
-    }
     /* Hidden, for bench/stability/atlas.py: MURK_SAMPLE_DUMP=FILE writes every sample's RGB as float32
      * [pixel][sample][r, g, b] (pixels row by row) after the render, for per-sample statistics (firefly
      * rate, largest sample, non-finite count). Up to 2^26 samples; not with --resume; under MPI, rank 0's
