@@ -559,7 +559,7 @@ static int make_reference(const bench *b, reference *r)
             break;
         }
         murk_render_result res;
-        if (isatty(STDERR_FILENO) && !b->assemble)
+        if (murk_cli_progress() && !b->assemble)
             fprintf(stderr, "\rmurk bench: reference chunk %d of %d (%d spp)...   ", c + 1, REF_CHUNKS, o.spp);
         if (bench_render(b, -1, 0, c, sets, n + 1, &o, r->w, r->h, &res) != 0) {
             rc = -1;
@@ -572,7 +572,7 @@ static int make_reference(const bench *b, reference *r)
         }
         free(res.rgb);
     }
-    if (isatty(STDERR_FILENO))
+    if (murk_cli_progress() && !b->assemble)
         fputc('\n', stderr);
     if (rc == 0) {
         r->rgb = murk_xmalloc(np * sizeof(float));
@@ -899,7 +899,7 @@ static int run_bench(const bench *b, int argc, char **argv)
             if (!stopped(b))
                 return 1;
             fprintf(stderr, "%smurk bench: interrupted (%s) while rendering the reference; nothing written\n",
-                    isatty(STDERR_FILENO) ? "\r\033[K" : "", murk_cli_stop_name());
+                    murk_cli_progress() ? "\r\033[K" : "", murk_cli_stop_name());
             return murk_cli_stop_status();
         }
         if (r.reused)
@@ -936,7 +936,7 @@ static int run_bench(const bench *b, int argc, char **argv)
     char *store[64];
     size_t nstore = 0;
     int rc = maps ? 0 : 1, count = 0, done = 0, total = b->nbudgets * b->repeat * b->nvariants;
-    int tty = isatty(STDERR_FILENO);
+    int tty = murk_cli_progress();
     for (int bi = 0; bi < b->nbudgets && !rc && !stopped(b); bi++)
         for (int k = 0; k < b->repeat && !rc && !stopped(b); k++)
             for (int v = 0; v < b->nvariants && !rc && !stopped(b); v++) { /* variants innermost: A B A B */
@@ -1184,7 +1184,9 @@ static int emit_jobs(const bench *b, int argc, char **argv)
 static const char bench_usage[] =
     "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
     "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
-    "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n";
+    "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n"
+    "SIGINT/SIGTERM abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
+    "(never bench.csv) and murk exits with 128 + the signal.\n";
 
 int murk_cli_bench(int argc, char **argv)
 {

@@ -244,6 +244,13 @@ int murk_cli_stop_status(void) { return 128 + (render_signal ? (int)render_signa
 
 const char *murk_cli_stop_name(void) { return render_signal == SIGTERM ? "SIGTERM" : "SIGINT"; }
 
+/* Under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar. */
+int murk_cli_progress(void)
+{
+    const char *e = getenv("MURK_PROGRESS");
+    return isatty(STDERR_FILENO) || (e && !strcmp(e, "1"));
+}
+
 /* ---- render under MPI -------------------------------------------------------------------------
  * Every rank runs cmd_render. Until the scene is loaded, the ranks other than 0 write their messages
  * into a temporary file instead of stderr (the same warnings as rank 0's, once per rank, are noise).
@@ -474,8 +481,7 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    /* under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar */
-    opts.progress = !quiet && (isatty(STDERR_FILENO) || (getenv("MURK_PROGRESS") && !strcmp(getenv("MURK_PROGRESS"), "1")));
+    opts.progress = !quiet && murk_cli_progress();
     char setbuf[4096] = "", ckid[4200], parttag[64] = "", fingerprint[4400];
     for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
         k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);

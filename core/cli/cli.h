@@ -24,6 +24,8 @@ int murk_cli_usage(const char *msg);   /* the message and the usage text on stde
 volatile sig_atomic_t *murk_cli_catch_stop_signals(void);
 int murk_cli_stop_status(void);
 const char *murk_cli_stop_name(void);
+/* 1 if progress goes to stderr: a terminal, or MURK_PROGRESS=1 (mpirun's pipe, a test's file). */
+int murk_cli_progress(void);
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
 int murk_cli_bench(int argc, char **argv);   /* bench.c */
