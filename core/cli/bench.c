@@ -996,17 +996,16 @@ static int run_bench(const bench *b, int argc, char **argv)
     if (rc == 0 && done < total) { /* a signal: only the whole renders' rows, never as bench.csv */
         int cached = !b->reference && !r.reused && access(r.path, R_OK) == 0; /* rendered by this run */
         snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
-        if (done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) != 0) {
+        int kept = done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) == 0;
+        if (done > 0 && !kept)
             fprintf(stderr, "murk: %s\n", err);
-            done = 0;
-        }
-        if (done > 0)
+        if (kept)
             fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; their rows are in %s (the columns "
                     "of bench.csv); no bench.csv, bench.json, maps or charts were written\n", murk_cli_stop_name(),
                     done, total, murk_cli_q(path));
         else
-            fprintf(stderr, "murk bench: interrupted (%s) after 0 of %d renders; nothing written%s%s%s\n",
-                    murk_cli_stop_name(), total, cached ? " but the reference, cached in " : "",
+            fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; nothing written%s%s%s\n",
+                    murk_cli_stop_name(), done, total, cached ? " but the reference, cached in " : "",
                     cached ? murk_cli_q(r.path) : "", cached ? " for the next bench" : "");
         rc = murk_cli_stop_status();
     }
