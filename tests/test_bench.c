@@ -1,16 +1,21 @@
 /* test_bench.c — `murk bench` end to end on a tiny scene (rows, charts, report, a wrong --vary caught
  * before rendering, the cached reference reused and then invalidated), the noise-corrected relMSE
- * of metrics.c (the code murk bench and murk compare share), and murk compare's bias test, --json,
- * --crop and maps. */
+ * of metrics.c (the code murk bench and murk compare share), murk compare's bias test, --json, --crop
+ * and maps, and a bench interrupted by SIGINT/SIGTERM (whole rows only, nothing half-written). */
 #include "testutil.h"
 
 #include "metrics.h"
 #include "murk/murk.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 static const char tiny[] =
@@ -228,6 +233,169 @@ static void compare_two_seeds(void **state)
     free(out);
 }
 
+
+/* ---- interrupted benches ---- */
+
+/* tmp_dir()/NAME (the output folder), NAME_cache (MURK_CACHE_DIR) and NAME.log, each 512 bytes. */
+static void bench_paths(const char *name, char *out, char *cache, char *log)
+{
+    snprintf(out, 512, "%s/%s", tmp_dir(), name);
+    snprintf(cache, 512, "%s/%s_cache", tmp_dir(), name);
+    snprintf(log, 512, "%s/%s.log", tmp_dir(), name);
+}
+
+/* Starts `murk bench ARGS` with its cache in cache (MURK_CACHE_DIR) and its stdout and stderr, progress
+ * lines included (MURK_PROGRESS=1), into log. */
+static pid_t start_bench(const char *log, const char *cache, const char *const *args)
+{
+    const char *argv[64];
+    int n = 0;
+    const char *exe = getenv("MURK_EXE");
+    argv[n++] = exe && *exe ? exe : "build/core/murk";
+    argv[n++] = "bench";
+    for (; *args && n < 63; args++)
+        argv[n++] = *args;
+    argv[n] = NULL;
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd < 0)
+            _exit(127);
+        dup2(fd, 1);
+        dup2(fd, 2);
+        setenv("MURK_CACHE_DIR", cache, 1);
+        setenv("MURK_PROGRESS", "1", 1);
+        execv(argv[0], (char *const *)argv);
+        _exit(127);
+    }
+    return pid;
+}
+
+static char *slurp_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = calloc(1, 1 << 20);
+    if (f) {
+        size_t n = fread(buf, 1, (1 << 20) - 1, f);
+        buf[n] = 0;
+        fclose(f);
+    }
+    return buf;
+}
+
+/* Waits (up to 5 minutes) until log contains what; fails if the bench ended first. */
+static void wait_for(pid_t pid, const char *log, const char *what)
+{
+    struct timespec ts = {0, 10 * 1000 * 1000};
+    for (int i = 0; i < 30000; i++) {
+        char *text = slurp_file(log);
+        int found = strstr(text, what) != NULL;
+        if (!found && waitpid(pid, NULL, WNOHANG) == pid)
+            fail_msg("murk bench ended before '%s':\n%s", what, text);
+        free(text);
+        if (found)
+            return;
+        nanosleep(&ts, NULL);
+    }
+    fail_msg("murk bench never printed '%s'", what);
+}
+
+/* The files of dir (none if it does not exist): fails on a temporary (NAME.tmp-PID or NAME.tmp); returns
+ * how many there are. */
+static int files_without_temporaries(const char *dir)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    if (!d)
+        return 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+            continue;
+        if (strstr(e->d_name, ".tmp"))
+            fail_msg("a temporary was left behind: %s/%s", dir, e->d_name);
+        n++;
+    }
+    closedir(d);
+    return n;
+}
+
+static int wait_exit(pid_t pid)
+{
+    int st = 0;
+    assert_int_equal(waitpid(pid, &st, 0), pid);
+    if (!WIFEXITED(st))
+        fail_msg("murk bench was killed by signal %d instead of exiting", WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    return WEXITSTATUS(st);
+}
+
+/* SIGINT after some renders of a long bench (2 variants x 1000 seeds): exit status 130, the message says how
+ * many renders were whole and where their rows are; bench-interrupted.csv holds the header and exactly
+ * those rows, each whole (every column); no bench.csv, bench.json, maps or charts; no temporary in the
+ * output folder or the cache, where the reference finished before the signal stays (both files). */
+static void bench_sigint_keeps_whole_rows(void **state)
+{
+    (void)state;
+    const char *scene = write_tiny("[0.2, 0.2, 0.2]");
+    char out[512], cache[512], log[512];
+    bench_paths("int_rows", out, cache, log);
+    const char *args[] = {scene, "--vary", "media.smoke.type=delta,decomposition", "--spp", "16", "--repeat", "1000",
+                          "--ref-spp", "16", "--threads", "1", "-o", out, NULL};
+    pid_t pid = start_bench(log, cache, args);
+    wait_for(pid, log, "[3/2000]"); /* two renders are whole, the third is running */
+    kill(pid, SIGINT);
+    assert_int_equal(wait_exit(pid), 130);
+    char *text = slurp_file(log);
+    const char *msg = strstr(text, "murk bench: interrupted (SIGINT) after ");
+    if (!msg)
+        fail_msg("no interruption message:\n%s", text);
+    int done = atoi(msg + strlen("murk bench: interrupted (SIGINT) after "));
+    char expect[1024];
+    snprintf(expect, sizeof expect, "after %d of 2000 renders; their rows are in %s/bench-interrupted.csv", done, out);
+    assert_contains(text, expect);
+    assert_true(done >= 2 && done < 2000);
+    free(text);
+    assert_int_equal(files_without_temporaries(out), 1); /* bench-interrupted.csv alone */
+    assert_int_equal(files_without_temporaries(cache), 2); /* the reference and its variance */
+    char path[1024];
+    snprintf(path, sizeof path, "%s/bench-interrupted.csv", out);
+    char *csv = slurp_file(path);
+    int rows = -1, columns = 0;
+    for (char *line = strtok(csv, "\n"); line; line = strtok(NULL, "\n"), rows++) {
+        int c = 1;
+        for (char *p = line; *p; p++)
+            c += *p == ',';
+        if (rows < 0)
+            columns = c;
+        else if (c != columns)
+            fail_msg("row %d has %d columns, the header %d: %s", rows + 1, c, columns, line);
+    }
+    assert_int_equal(rows, done);
+    assert_int_equal(columns, 20);
+    free(csv);
+}
+
+/* SIGTERM while the reference renders: exit status 143, "nothing written", and nothing is: no output folder
+ * (the bench made it, so it goes again), no cache file, no temporary. */
+static void bench_sigterm_in_reference_writes_nothing(void **state)
+{
+    (void)state;
+    const char *scene = write_tiny("[0.2, 0.2, 0.2]");
+    char out[512], cache[512], log[512];
+    bench_paths("int_ref", out, cache, log);
+    const char *args[] = {scene, "--spp", "4", "--ref-spp", "400000", "--threads", "1", "-o", out, NULL};
+    pid_t pid = start_bench(log, cache, args);
+    wait_for(pid, log, "reference chunk 1 of 4");
+    kill(pid, SIGTERM);
+    assert_int_equal(wait_exit(pid), 143);
+    char *text = slurp_file(log);
+    assert_contains(text, "murk bench: interrupted (SIGTERM) while rendering the reference; nothing written");
+    free(text);
+    struct stat st;
+    assert_int_not_equal(stat(out, &st), 0);
+    assert_int_equal(files_without_temporaries(cache), 0);
+}
+
 int main(void)
 {
     char cache[512]; /* no test writes a reference into the user's cache */
@@ -238,6 +406,8 @@ int main(void)
         cmocka_unit_test(corrected_relmse_of_two_seeds),
         cmocka_unit_test(compare_two_seeds),
         cmocka_unit_test(bench_end_to_end),
+        cmocka_unit_test(bench_sigint_keeps_whole_rows),
+        cmocka_unit_test(bench_sigterm_in_reference_writes_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,10 +1,12 @@
-/* test_counters.c — the cost counters (murk/counters.h): a closed form for tentative collisions, zero
- * lookups without media, and per-thread counts that merge to the same totals on any thread count. */
+/* test_counters.c — the cost counters (murk/counters.h): a closed form for tentative collisions, every
+ * estimator's and tracker's collisions against its lookups, zero lookups without media, and per-thread
+ * counts that merge to the same totals on any thread count. */
 #include "mediatest.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* Delta tracking in a homogeneous slab of extinction mu and length L, with the majorant f x mu: the
  * tentative collisions are a Poisson process of rate f mu, thinned with probability 1/f into the real
@@ -47,6 +49,95 @@ static void slab_closed_form(void **state)
     double ps = 1.0 - exp(-mu * L), sp = sqrt(ps * (1.0 - ps) / n);
     assert_true(fabs((double)scattered / n - ps) < 4.0 * sp);
     assert_true(c->cells >= (uint64_t)n); /* every flight enters the constant field's one cell */
+    murk_scene_free(s);
+}
+
+/* The collisions every estimator and tracker counts, against its lookups (murk/counters.h), on a
+ * constant medium (density 0.5, sigma_t 1.2, majorant_factor 2: tau_bar = 2.4 on a ray of length 2):
+ *  - the transmittance estimators that draw points (ratio, residual_ratio, track_length, power_series)
+ *    read the density once per point and nowhere else: collisions == lookups > 0, exactly;
+ *  - the ray marchers (raymarch, unbiased_raymarch) draw no collision points: 0 collisions, lookups > 0;
+ *  - power_series' one chunk (tau_bar 2.4 < chunk_depth 4) has N = max(K, k0) points, K ~ Poisson(2.4)
+ *    and k0 the order where the Poisson CMF reaches 1 - 1e-8: E[collisions] = sum_k max(k, k0) Pois(k),
+ *    checked within 4 se (+ 1e-9 relative: N is k0 but for a 1e-8 tail, so se is about 0);
+ *  - every tracker's free flights (sample()) and its own transmittance(): collisions == lookups > 0,
+ *    but decomposition's control collisions, which read no density and end the flight:
+ *    lookups <= collisions <= lookups + flights.
+ * power_series once counted nothing (bench.csv's collisions column 0): the first check failed. */
+static void collisions_match_lookups(void **state)
+{
+    (void)state;
+    static const mt_spec est[] = {
+        {"ratio", "type: delta, transmittance: ratio", 0},
+        {"residual_ratio", "type: delta, transmittance: { type: residual_ratio, control: 0.5 }", 0},
+        {"track_length", "type: delta, transmittance: track_length", 0},
+        {"power_series", "type: delta, transmittance: power_series", 0},
+        {"raymarch", "type: delta, transmittance: raymarch", 0},
+        {"unbiased_raymarch", "type: delta, transmittance: unbiased_raymarch", 0},
+        {"delta", "type: delta", 0},
+        {"spectral", "type: spectral", 0},
+        {"naive_spectral", "type: naive_spectral", 0},
+        {"spectral_mis", "type: spectral_mis", 0},
+        {"decomposition", "type: decomposition", 0},
+    };
+    enum { NEST = sizeof est / sizeof est[0], NPOINTS = 4, NRAYMARCH = 6 };
+    const double L = 2.0, tau = 2.0 * 0.5 * 1.2 * L; /* majorant_factor x density x sigma_t x length */
+    murk_scene *s = mt_load_media("collide.yaml", MT_GREY_KEYS ", density: { constant: 0.5 }, majorant_factor: 2",
+                                  "", est, NEST);
+    const int n = 20000;
+    for (int e = 0; e < NEST; e++) {
+        const murk_medium *m = &s->media[e].m;
+        int calls = e < NRAYMARCH ? 1 : 2; /* an estimator: transmittance(); a tracker: sample() too */
+        for (int call = 0; call < calls; call++) {
+            murk_host_thread_reset();
+            murk_rng rng;
+            murk_rng_seed(&rng, 29, (uint64_t)e, (uint64_t)call);
+            double sum = 0, sum2 = 0;
+            for (int i = 0; i < n; i++) {
+                murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
+                murk_path_ctx ctx = {mt_hero(&rng), murk_rgb1(1.0f)};
+                murk_medium_event ev;
+                uint64_t before = murk_thread_counters[e].collisions;
+                if (call == 0)
+                    (void)murk_medium_transmittance(m, &ray, &ctx, &rng);
+                else
+                    m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
+                double k = (double)(murk_thread_counters[e].collisions - before);
+                sum += k;
+                sum2 += k * k;
+            }
+            const murk_counters *c = &murk_thread_counters[e];
+            printf("%-18s %-13s %9llu collisions %9llu lookups (%.4f per call)\n", est[e].label,
+                   call ? "sample" : "transmittance", (unsigned long long)c->collisions,
+                   (unsigned long long)c->lookups, sum / n);
+            assert_true(c->lookups > 0);
+            if (e >= NPOINTS && e < NRAYMARCH) {
+                assert_true(c->collisions == 0);
+            } else if (call == 1 && !strcmp(est[e].label, "decomposition")) {
+                assert_true(c->collisions >= c->lookups && c->collisions <= c->lookups + (uint64_t)n);
+                assert_true(c->collisions > c->lookups); /* some flights end at a control collision */
+            } else {
+                assert_true(c->collisions == c->lookups);
+            }
+            if (!strcmp(est[e].label, "power_series")) {
+                int k0 = 0; /* as power_series.c finds it */
+                double pk = exp(-tau), cmf = pk, expect = 0.0, pj = exp(-tau);
+                while (cmf < 1.0 - 1e-8) {
+                    k0++;
+                    pk *= tau / k0;
+                    cmf += pk;
+                }
+                for (int j = 0; j < 200; j++) {
+                    if (j > 0)
+                        pj *= tau / j;
+                    expect += (j > k0 ? j : k0) * pj;
+                }
+                double mean = sum / n, se = sqrt(fmax(0.0, (sum2 - sum * sum / n) / (n - 1)) / n);
+                printf("  power_series: %.6f points per estimate, E max(K, k0 = %d) = %.6f\n", mean, k0, expect);
+                assert_true(fabs(mean - expect) <= 4.0 * se + 1e-9 * expect);
+            }
+        }
+    }
     murk_scene_free(s);
 }
 
@@ -117,6 +208,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(slab_closed_form),
+        cmocka_unit_test(collisions_match_lookups),
         cmocka_unit_test(no_media_no_lookups),
         cmocka_unit_test(per_medium_any_threads),
     };

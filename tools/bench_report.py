@@ -12,6 +12,7 @@ import json
 import math
 import os
 import platform
+import signal
 import sys
 
 import warnings
@@ -75,9 +76,23 @@ def efficiency(s, cost):
     return f, f * math.sqrt((se / e) ** 2 + ((sc if sc == sc else 0) / c) ** 2)
 
 
+def write_atomic(path, write):
+    """write(tmp) fills a temporary beside path, renamed over it when whole; removed if interrupted
+    (murk bench passes SIGINT/SIGTERM on: KeyboardInterrupt here), so no chart is ever half-written."""
+    tmp = "%s.tmp-%d" % (path, os.getpid())
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
 def save(fig, d, name):
     for ext in ("png", "svg"):
-        fig.savefig(os.path.join(d, name + "." + ext), dpi=110, bbox_inches="tight")
+        write_atomic(os.path.join(d, name + "." + ext),
+                     lambda tmp: fig.savefig(tmp, format=ext, dpi=110, bbox_inches="tight"))
     plt.close(fig)
 
 
@@ -300,11 +315,14 @@ def report(d, meta, agg, shares):
           "Which variant is most efficient where (per pixel, largest budget):", "",
           "![efficiency map](efficiency_map.png)", "",
           "Every render's figures: [bench.csv](bench.csv).", ""]
-    with open(os.path.join(d, "report.md"), "w") as f:
-        f.write("\n".join(L))
+    def write(tmp):
+        with open(tmp, "w") as f:
+            f.write("\n".join(L))
+    write_atomic(os.path.join(d, "report.md"), write)
 
 
 def main():
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # SIGTERM too removes the temporary
     if len(sys.argv) != 2:
         sys.exit("usage: bench_report.py DIR (a murk bench output folder)")
     d = sys.argv[1]
@@ -319,4 +337,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except KeyboardInterrupt:  # SIGINT or SIGTERM (murk bench says what happened); no traceback
+        sys.exit(130)

@@ -4,6 +4,7 @@
  * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
  * the charts and report.md. Also the counters' text forms (the end-of-render summary, murk:counters).
  * Part of the murk executable. */
+#include "atomic.h"
 #include "cli.h"
 #include "image.h"
 #include "media.h"
@@ -17,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -132,9 +134,13 @@ typedef struct bench {
     int nbudgets, time_mode, repeat, threads, ref_spp, charts;
     const char *jobs; /* --emit-jobs DIR or --assemble DIR */
     int assemble;
+    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM (murk_cli_catch_stop_signals) */
 } bench;
 
 enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
+
+/* A signal asked the bench to stop. */
+static int stopped(const bench *b) { return b->stop && *b->stop; }
 
 static char **split_list(const char *s, int *n)
 {
@@ -470,7 +476,8 @@ static int read_job(const char *path, int w, int h, murk_render_result *res)
     return 0;
 }
 
-/* Renders (or, --assemble, reads) one render of the bench. 0, or -1 after a message. */
+/* Renders (or, --assemble, reads) one render of the bench. 0; 1 when a signal abandoned it (no image:
+ * only whole renders count); or -1 after a message. */
 static int bench_render(const bench *b, int v, int bi, int k, const char *const *sets, size_t n,
                         const murk_render_opts *o, int w, int h, murk_render_result *res)
 {
@@ -489,13 +496,19 @@ static int bench_render(const bench *b, int v, int bi, int k, const char *const 
     if (rc != 0)
         fprintf(stderr, "\nmurk: %s\n", err);
     murk_scene_free(s);
+    if (rc == 0 && res->interrupted) {
+        free(res->rgb);
+        res->rgb = NULL;
+        return 1;
+    }
     return rc ? -1 : 0;
 }
 
 /* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
  * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
  * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the content hash of the scene file and
- * of every file it loads, the --set overrides, the spp and murk's version. */
+ * of every file it loads, the --set overrides, the spp and murk's version: the mean and the variance as
+ * one group of atomic writes (both files or neither). A stop signal abandons it (-1, nothing cached). */
 static int make_reference(const bench *b, reference *r)
 {
     char err[2048], dir[3072];
@@ -539,9 +552,14 @@ static int make_reference(const bench *b, reference *r)
         char seed[40];
         snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
         sets[n] = seed;
-        murk_render_opts o = {.spp = (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, .threads = b->threads};
+        murk_render_opts o = {.spp = (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, .threads = b->threads,
+                              .stop = b->stop};
+        if (stopped(b)) {
+            rc = -1;
+            break;
+        }
         murk_render_result res;
-        if (isatty(STDERR_FILENO) && !b->assemble)
+        if (murk_cli_progress() && !b->assemble)
             fprintf(stderr, "\rmurk bench: reference chunk %d of %d (%d spp)...   ", c + 1, REF_CHUNKS, o.spp);
         if (bench_render(b, -1, 0, c, sets, n + 1, &o, r->w, r->h, &res) != 0) {
             rc = -1;
@@ -554,7 +572,7 @@ static int make_reference(const bench *b, reference *r)
         }
         free(res.rgb);
     }
-    if (isatty(STDERR_FILENO))
+    if (murk_cli_progress() && !b->assemble)
         fputc('\n', stderr);
     if (rc == 0) {
         r->rgb = murk_xmalloc(np * sizeof(float));
@@ -569,10 +587,15 @@ static int make_reference(const bench *b, reference *r)
         murk_kv meta[] = {{"murk:scene", b->scene}, {"murk:spp", spp}, {"murk:version", MURK_VERSION},
                           {"murk:bench", "reference: the mean of 4 chunks"}};
         murk_kv vmeta[] = {{"murk:scene", b->scene}, {"murk:bench", "variance of the reference's per-pixel mean"}};
+        err[0] = 0;
+        murk_output_begin();
         if (mkdirs(dir) != 0 || murk_exr_write(r->path, r->rgb, r->w, r->h, meta, 4, err, sizeof err) != 0 ||
-            murk_exr_write(var_path, r->var, r->w, r->h, vmeta, 2, err, sizeof err) != 0)
+            murk_exr_write(var_path, r->var, r->w, r->h, vmeta, 2, err, sizeof err) != 0 ||
+            murk_output_commit(err, sizeof err) != 0) {
+            murk_output_abort();
             fprintf(stderr, "murk: warning: could not cache the reference in %s (%s); it will be rendered again "
-                    "next time\n", murk_cli_q(dir), errno ? strerror(errno) : err);
+                    "next time\n", murk_cli_q(dir), err[0] ? err : strerror(errno));
+        }
     }
     free(s1);
     free(s2);
@@ -609,12 +632,34 @@ static void csv_str(FILE *f, const char *s)
     fputc('"', f);
 }
 
-/* A float32 .npy file of h x w values (numpy's format 1.0). */
-static int write_npy(const char *path, const float *v, int w, int h)
+/* Every output file of the bench goes through murk_write_atomic (atomic.h): a temporary beside it,
+ * renamed over it when whole. These fill the temporary. */
+
+typedef struct text_job {
+    const char *p;
+    size_t n;
+} text_job;
+
+static int text_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return -1;
+    const text_job *t = user;
+    (void)tmp, (void)err, (void)errlen;
+    fwrite(t->p, 1, t->n, f); /* murk_write_atomic checks the stream */
+    return 0;
+}
+
+typedef struct npy_job {
+    const float *v;
+    int w, h;
+} npy_job;
+
+/* A float32 .npy file of h x w values (numpy's format 1.0). */
+static int npy_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
+{
+    const npy_job *j = user;
+    const float *v = j->v;
+    int w = j->w, h = j->h;
+    (void)tmp, (void)err, (void)errlen;
     char head[128];
     int n = snprintf(head, sizeof head, "{'descr': '<f4', 'fortran_order': False, 'shape': (%d, %d), }", h, w);
     int total = 10 + n + 1, pad = (64 - total % 64) % 64;
@@ -627,7 +672,7 @@ static int write_npy(const char *path, const float *v, int w, int h)
         fputc(' ', f);
     fputc('\n', f);
     fwrite(v, sizeof(float), (size_t)w * (size_t)h, f);
-    return fclose(f) == 0 ? 0 : -1;
+    return 0;
 }
 
 /* Where the chart script is: $MURK_BENCH_SCRIPT; beside the build tree's murk (build/tools/); where an
@@ -716,12 +761,22 @@ static void shell_quoted(FILE *f, int argc, char **argv)
         shell_word(f, argv[i]);
 }
 
+typedef struct meta_job {
+    const bench *b;
+    const reference *r;
+    int argc;
+    char **argv;
+} meta_job;
+
 /* bench.json: what the chart script needs besides bench.csv. */
-static int write_meta(const bench *b, const reference *r, int argc, char **argv, const char *path)
+static int meta_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
+    const meta_job *j = user;
+    const bench *b = j->b;
+    const reference *r = j->r;
+    int argc = j->argc;
+    char **argv = j->argv;
+    (void)tmp, (void)err, (void)errlen;
     char cmd[65536];
     FILE *m = fmemopen(cmd, sizeof cmd, "w");
     if (m) {
@@ -763,12 +818,66 @@ static int write_meta(const bench *b, const reference *r, int argc, char **argv,
         json_str(f, label);
     }
     fprintf(f, "]\n}\n");
-    return fclose(f) == 0 ? 0 : -1;
+    return 0;
+}
+
+/* The chart script (tools/bench_report.py DIR) as a child process, without a shell, once every render is
+ * done and bench.csv, bench.json and maps/ are written. It runs in its own process group, so a Ctrl-C
+ * reaches murk alone, and murk passes a SIGINT or SIGTERM on to it once: the script then removes the
+ * chart it was writing (every chart is a temporary renamed when whole). A signal that came before it
+ * started: no charts. 0, or the exit status after a message. */
+static int run_charts(const bench *b)
+{
+    char script[8192];
+    script_path(script, sizeof script);
+    const char *py = getenv("MURK_PYTHON");
+    if (!py || !*py)
+        py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
+    if (stopped(b)) {
+        fprintf(stderr, "murk bench: interrupted (%s) after the last render; bench.csv, bench.json and maps/ are "
+                "whole, no charts (%s %s %s makes them)\n", murk_cli_stop_name(), murk_cli_q(py), murk_cli_q(script),
+                murk_cli_q(b->out));
+        return murk_cli_stop_status();
+    }
+    if (!b->charts)
+        return 0;
+    fflush(stdout);
+    fflush(stderr);
+    pid_t pid = fork();
+    if (pid == 0) {
+        setpgid(0, 0);
+        execlp(py, py, script, b->out, (char *)NULL);
+        fprintf(stderr, "murk: cannot run %s: %s\n", murk_cli_q(py), strerror(errno));
+        _exit(127);
+    }
+    int st = -1, passed = 0;
+    while (pid > 0) {
+        if (stopped(b) && !passed) {
+            kill(pid, murk_cli_stop_status() - 128);
+            passed = 1;
+        }
+        if (waitpid(pid, &st, 0) == pid || errno != EINTR)
+            break;
+    }
+    if (stopped(b)) {
+        fprintf(stderr, "murk bench: interrupted (%s) while making the charts; bench.csv, bench.json and maps/ "
+                "are whole, some charts may be missing (%s %s %s makes them)\n", murk_cli_stop_name(), murk_cli_q(py),
+                murk_cli_q(script), murk_cli_q(b->out));
+        return murk_cli_stop_status();
+    }
+    if (pid < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+        fprintf(stderr, "murk: the chart script failed (%s %s: %s %d); bench.csv is complete. It needs python3 "
+                "with matplotlib and numpy (Debian: python3-matplotlib python3-numpy)\n", murk_cli_q(py),
+                murk_cli_q(script), pid < 0 ? "fork failed, errno" : WIFEXITED(st) ? "status" : "signal",
+                pid < 0 ? errno : WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
+        return 1;
+    }
+    return 0;
 }
 
 static int run_bench(const bench *b, int argc, char **argv)
 {
-    char err[2048], path[8192], tmp[8200];
+    char err[2048], path[8192];
     murk_scene *s0 = load_with(b, b->sets, b->nsets, err, sizeof err);
     if (!s0) {
         fprintf(stderr, "%s\n", err);
@@ -787,7 +896,11 @@ static int run_bench(const bench *b, int argc, char **argv)
     } else {
         if (make_reference(b, &r) != 0) {
             ref_free(&r);
-            return 1;
+            if (!stopped(b))
+                return 1;
+            fprintf(stderr, "%smurk bench: interrupted (%s) while rendering the reference; nothing written\n",
+                    murk_cli_progress() ? "\r\033[K" : "", murk_cli_stop_name());
+            return murk_cli_stop_status();
         }
         if (r.reused)
             printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
@@ -797,11 +910,11 @@ static int run_bench(const bench *b, int argc, char **argv)
                    REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS, r.seconds);
     }
     fflush(stdout);
-    snprintf(path, sizeof path, "%s/bench.csv", b->out);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *csv = fopen(tmp, "w");
+    char *rows = NULL;
+    size_t rows_len = 0;
+    FILE *csv = open_memstream(&rows, &rows_len); /* bench.csv, written whole at the end */
     if (!csv) {
-        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(tmp), strerror(errno));
+        fprintf(stderr, "murk: out of memory\n");
         ref_free(&r);
         return 1;
     }
@@ -822,10 +935,11 @@ static int run_bench(const bench *b, int argc, char **argv)
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
     char *store[64];
     size_t nstore = 0;
-    int rc = maps ? 0 : 1, count = 0, total = b->nbudgets * b->repeat * b->nvariants, tty = isatty(STDERR_FILENO);
-    for (int bi = 0; bi < b->nbudgets && !rc; bi++)
-        for (int k = 0; k < b->repeat && !rc; k++)
-            for (int v = 0; v < b->nvariants && !rc; v++) { /* variants innermost: A B A B, drift hits all */
+    int rc = maps ? 0 : 1, count = 0, done = 0, total = b->nbudgets * b->repeat * b->nvariants;
+    int tty = murk_cli_progress();
+    for (int bi = 0; bi < b->nbudgets && !rc && !stopped(b); bi++)
+        for (int k = 0; k < b->repeat && !rc && !stopped(b); k++)
+            for (int v = 0; v < b->nvariants && !rc && !stopped(b); v++) { /* variants innermost: A B A B */
                 char label[1024], eta[32] = "?";
                 variant_label(b, v, label, sizeof label);
                 if (done_w > 0)
@@ -837,7 +951,7 @@ static int run_bench(const bench *b, int argc, char **argv)
                     fflush(stderr);
                 }
                 size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                murk_render_opts o = {.threads = b->threads};
+                murk_render_opts o = {.threads = b->threads, .stop = b->stop};
                 if (b->time_mode) {
                     o.time_limit = b->budgets[bi];
                     o.spp = 1 << 24;
@@ -847,9 +961,9 @@ static int run_bench(const bench *b, int argc, char **argv)
                 murk_render_result res;
                 int failed = bench_render(b, v, bi, k, sets, n, &o, r.w, r.h, &res);
                 free_store(store, &nstore);
-                if (failed) {
+                if (failed < 0) {
                     rc = 1;
-                } else {
+                } else if (failed == 0) {
                     murk_metrics m;
                     murk_metrics_compute(res.rgb, r.rgb, r.var, r.w, (murk_crop){0, 0, r.w, r.h}, &m, pix);
                     murk_counters t = counters_total(&res);
@@ -865,6 +979,7 @@ static int run_bench(const bench *b, int argc, char **argv)
                     if (bi == big)
                         for (size_t p = 0; p < np; p++)
                             maps[(size_t)v * np + p] += isfinite(pix[p]) ? pix[p] / b->repeat : 0.0;
+                    done++;
                 }
                 done_w += b->budgets[bi];
                 free(res.rgb);
@@ -872,29 +987,58 @@ static int run_bench(const bench *b, int argc, char **argv)
             }
     if (tty)
         fprintf(stderr, "\r\033[K");
-    int closed = fclose(csv);
-    if (rc == 0 && (closed != 0 || rename(tmp, path) != 0)) {
-        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+    int bad = fclose(csv) != 0;
+    text_job csv_text = {rows, rows_len};
+    if (rc == 0 && (bad || !rows)) {
+        fprintf(stderr, "murk: out of memory\n");
         rc = 1;
     }
-    if (rc)
-        remove(tmp);
+    if (rc == 0 && done < total) { /* a signal: only the whole renders' rows, never as bench.csv */
+        int cached = !b->reference && !r.reused && access(r.path, R_OK) == 0; /* rendered by this run */
+        snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
+        int kept = done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) == 0;
+        if (done > 0 && !kept)
+            fprintf(stderr, "murk: %s\n", err);
+        if (kept)
+            fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; their rows are in %s (the columns "
+                    "of bench.csv); no bench.csv, bench.json, maps or charts were written\n", murk_cli_stop_name(),
+                    done, total, murk_cli_q(path));
+        else
+            fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; nothing written%s%s%s\n",
+                    murk_cli_stop_name(), done, total, cached ? " but the reference, cached in " : "",
+                    cached ? murk_cli_q(r.path) : "", cached ? " for the next bench" : "");
+        rc = murk_cli_stop_status();
+    }
+    snprintf(path, sizeof path, "%s/bench.csv", b->out);
+    if (rc == 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) != 0) {
+        fprintf(stderr, "murk: %s\n", err);
+        rc = 1;
+    }
+    if (rc == 0) { /* a stale partial bench of an earlier run would sit beside the whole one */
+        snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
+        remove(path);
+    }
+    free(rows);
     /* the per-pixel maps of the largest budget, and the meta data */
     snprintf(path, sizeof path, "%s/maps", b->out);
-    if (rc == 0 && mkdirs(path) != 0)
+    if (rc == 0 && mkdirs(path) != 0) {
+        fprintf(stderr, "murk: cannot create %s: %s\n", murk_cli_q(path), strerror(errno));
         rc = 1;
+    }
     for (int v = 0; v < b->nvariants && rc == 0; v++) {
         for (size_t p = 0; p < np; p++)
             pix[p] = (float)maps[(size_t)v * np + p];
         snprintf(path, sizeof path, "%s/maps/variant%d.npy", b->out, v);
-        if (write_npy(path, pix, r.w, r.h) != 0) {
-            fprintf(stderr, "murk: cannot write %s\n", murk_cli_q(path));
+        npy_job nj = {pix, r.w, r.h};
+        if (murk_write_atomic(path, npy_fill, &nj, err, sizeof err) != 0) {
+            fprintf(stderr, "murk: %s\n", err);
             rc = 1;
         }
     }
     snprintf(path, sizeof path, "%s/bench.json", b->out);
-    if (rc == 0 && write_meta(b, &r, argc, argv, path) != 0) {
-        fprintf(stderr, "murk: cannot write %s\n", murk_cli_q(path));
+    meta_job mj = {b, &r, argc, argv};
+    if (rc == 0 && murk_write_atomic(path, meta_fill, &mj, err, sizeof err) != 0) {
+        fprintf(stderr, "murk: %s\n", err);
         rc = 1;
     }
     free(pix);
@@ -904,26 +1048,8 @@ static int run_bench(const bench *b, int argc, char **argv)
     if (rc == 0)
         printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", total, b->nvariants,
                b->nbudgets, b->repeat, now() - t0, b->out);
-    if (rc == 0 && b->charts) {
-        char script[8192], cmd[32768];
-        script_path(script, sizeof script);
-        const char *py = getenv("MURK_PYTHON");
-        if (!py || !*py)
-            py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-        snprintf(cmd, sizeof cmd, "'%s' '%s' '%s'", py, script, b->out);
-        if (strchr(py, '\'') || strchr(script, '\'') || strchr(b->out, '\'')) {
-            fprintf(stderr, "murk: the charts need paths without a ' in them\n");
-            return 1;
-        }
-        fflush(stdout);
-        int st = system(cmd);
-        if (st != 0) {
-            fprintf(stderr, "murk: the chart script failed (%s %s: status %d); bench.csv is complete. It needs "
-                    "python3 with matplotlib and numpy (Debian: python3-matplotlib python3-numpy)\n",
-                    murk_cli_q(py), murk_cli_q(script), st);
-            rc = 1;
-        }
-    }
+    if (rc == 0)
+        rc = run_charts(b); /* and a signal after the last render is said there */
     return rc;
 }
 
@@ -1057,7 +1183,9 @@ static int emit_jobs(const bench *b, int argc, char **argv)
 static const char bench_usage[] =
     "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
     "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
-    "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n";
+    "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n"
+    "SIGINT/SIGTERM abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
+    "(never bench.csv) and murk exits with 128 + the signal.\n";
 
 int murk_cli_bench(int argc, char **argv)
 {
@@ -1187,12 +1315,19 @@ int murk_cli_bench(int argc, char **argv)
         rc = emit_jobs(&b, argc, argv);
         rc = rc ? rc : -1;
     }
+    struct stat st;
+    int made_out = rc == 0 && stat(b.out, &st) != 0;
+    if (rc == 0)
+        b.stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
     if (rc == 0 && mkdirs(b.out) != 0) {
         fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b.out), strerror(errno));
         rc = 1;
     }
-    if (rc == 0)
+    if (rc == 0) {
         rc = run_bench(&b, argc, argv);
+        if (rc > 128 && made_out)
+            rmdir(b.out); /* interrupted: the folder it made goes again if nothing was written into it */
+    }
     for (int j = 0; j < b.nvary; j++) {
         free(b.vary[j].key);
         free_list(b.vary[j].vals, b.vary[j].nvals);

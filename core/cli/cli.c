@@ -217,8 +217,10 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.0f ", v);
 }
 
-/* SIGINT/SIGTERM during `render`: the running pass is abandoned, the image of the whole passes done is
- * written (murk:interrupted says so) and murk exits with 128 + the signal's number. */
+/* SIGINT/SIGTERM during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set and
+ * murk goes on. render abandons the running pass, writes the image of the whole passes done
+ * (murk:interrupted says so) and exits with 128 + the signal's number; bench (bench.c) stops after the
+ * running render, keeps only whole renders' rows and exits the same way. */
 static volatile sig_atomic_t render_stop, render_signal;
 
 static void on_stop_signal(int sig)
@@ -227,7 +229,7 @@ static void on_stop_signal(int sig)
     render_stop = 1;
 }
 
-static void catch_stop_signals(void)
+volatile sig_atomic_t *murk_cli_catch_stop_signals(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -235,6 +237,18 @@ static void catch_stop_signals(void)
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    return &render_stop;
+}
+
+int murk_cli_stop_status(void) { return 128 + (render_signal ? (int)render_signal : SIGINT); }
+
+const char *murk_cli_stop_name(void) { return render_signal == SIGTERM ? "SIGTERM" : "SIGINT"; }
+
+/* Under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar. */
+int murk_cli_progress(void)
+{
+    const char *e = getenv("MURK_PROGRESS");
+    return isatty(STDERR_FILENO) || (e && !strcmp(e, "1"));
 }
 
 /* ---- render under MPI -------------------------------------------------------------------------
@@ -362,7 +376,7 @@ static int parse_part(const char *v, int *part, int *parts)
 
 static int render_main(int argc, char **argv)
 {
-    catch_stop_signals();
+    murk_cli_catch_stop_signals();
     const char *scene_path = NULL, *out = NULL;
     const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
     size_t nsets = 0;
@@ -467,8 +481,7 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    /* under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar */
-    opts.progress = !quiet && (isatty(STDERR_FILENO) || (getenv("MURK_PROGRESS") && !strcmp(getenv("MURK_PROGRESS"), "1")));
+    opts.progress = !quiet && murk_cli_progress();
     char setbuf[4096] = "", ckid[4200], parttag[64] = "", fingerprint[4400];
     for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
         k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
@@ -525,7 +538,7 @@ static int render_main(int argc, char **argv)
     snprintf(spp_asked, sizeof spp_asked, "%d", opts.spp > 0 ? opts.spp : s->spp);
     if (res.interrupted)
         snprintf(interrupted, sizeof interrupted, "%s after %d of %s spp",
-                 render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked);
+                 murk_cli_stop_name(), res.spp, spp_asked);
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
@@ -555,7 +568,7 @@ static int render_main(int argc, char **argv)
     int rc = ck_failed ? 1 : 0;
     if (res.interrupted)
         fprintf(stderr, "murk: interrupted (%s): writing the image with %d of %s spp%s%s\n",
-                render_signal == SIGTERM ? "SIGTERM" : "SIGINT", res.spp, spp_asked,
+                murk_cli_stop_name(), res.spp, spp_asked,
                 opts.checkpoint ? "; resume with --resume " : "", opts.checkpoint ? opts.checkpoint : "");
     murk_output_begin(); /* the EXR and its PNG: both files or neither */
     if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, nmeta, err, sizeof err) != 0 ||
@@ -566,7 +579,7 @@ static int render_main(int argc, char **argv)
         rc = 1;
     }
     if (res.interrupted || render_stop) /* also when the signal came during the writes and cut them short */
-        rc = 128 + (render_signal ? (int)render_signal : SIGINT);
+        rc = murk_cli_stop_status();
     if (rc == 0 && !quiet) {
         char sps[32], rps[32];
         human((double)res.samples / res.seconds, sps, sizeof sps);

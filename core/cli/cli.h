@@ -2,6 +2,7 @@
 #ifndef MURK_CLI_H
 #define MURK_CLI_H
 
+#include <signal.h>
 #include <stddef.h>
 
 /* Runs `murk render | info | plugins | compare | bench | merge | check | grid | help | --version | --help`;
@@ -17,6 +18,14 @@ struct murk_scene *murk_cli_load(const char *path, const char *const *sets, size
 const char *murk_cli_q(const char *s); /* untrusted text made printable (eight rotating buffers) */
 void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
 int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
+
+/* SIGINT and SIGTERM set the returned flag (murk_render_opts.stop) instead of ending murk: `render` and
+ * `bench` stop cleanly. Then the exit status, 128 + the signal, and its name ("SIGINT", "SIGTERM"). */
+volatile sig_atomic_t *murk_cli_catch_stop_signals(void);
+int murk_cli_stop_status(void);
+const char *murk_cli_stop_name(void);
+/* 1 if progress goes to stderr: a terminal, or MURK_PROGRESS=1 (mpirun's pipe, a test's file). */
+int murk_cli_progress(void);
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
 int murk_cli_bench(int argc, char **argv);   /* bench.c */

@@ -158,7 +158,7 @@ static int finish(FILE *fp, const char *tmp, const char *path, int rc, char *err
     return rc;
 }
 
-int murk_write_atomic(const char *path, murk_write_fn fill, void *user, char *err, size_t errlen)
+MURK_API int murk_write_atomic(const char *path, murk_write_fn fill, void *user, char *err, size_t errlen)
 {
     if (murk_output_check(path, err, errlen) != 0)
         return -1;

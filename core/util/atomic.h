@@ -1,5 +1,5 @@
-/* atomic.h — writing output files whole or not at all. Internal to libmurk (the murk_output_* group
- * calls are exported for the murk command).
+/* atomic.h — writing output files whole or not at all. Internal to libmurk (murk_write_atomic and the
+ * murk_output_* group calls are exported for the murk command: `murk bench` writes its files with them).
  *
  * Every file murk writes (the EXR and its PNG preview, a .vol from `murk grid`) goes through
  * murk_write_atomic: the content is written to PATH.tmp-PID beside the target, flushed to disk and

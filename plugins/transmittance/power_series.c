@@ -34,7 +34,9 @@
  * chunk (ratio-tracked; past 1024 points, stopped at 0). Such a chunk now counts as full, and a ratio-
  * tracked chunk has no point cap.
  * Cost: per chunk about max(K, k0) lookups (k0 = 20 at tau_bar 4, 68 at 32: the deeper chunks cost
- * fewer lookups per optical depth) plus O(N^2) arithmetic. Russian roulette between chunks (survival =
+ * fewer lookups per optical depth) plus O(N^2) arithmetic. Every point (Poisson, top-up or ratio-tracked)
+ * is one density lookup and one tentative collision in the cost counters (murk/counters.h), so in
+ * bench.csv its collisions equal its lookups. Russian roulette between chunks (survival =
  * the largest channel, once below 0.1), as ratio tracking. A chunk whose tau_bar exceeds 64 (one float
  * step of t holding a deep majorant) is ratio-tracked instead (unbiased); one with more than 1024 points
  * stops with a warning (biased; at tau_bar <= 64 never seen). */
@@ -82,9 +84,11 @@ static double hazard(int k, double tau)
     return 1.0 / s;
 }
 
-/* y_c = 1 - sigma_t,c(x) / mu at the point t of piece p. */
-static void point_y(const ps *m, const murk_ray *ray, const piece *p, float t, double y[3])
+/* y_c = 1 - sigma_t,c(x) / mu at the point t of piece p: one density lookup, counted as one tentative
+ * collision (murk/counters.h: every point of the series, Poisson or top-up, is one). */
+static void point_y(const ps *m, const murk_ray *ray, const piece *p, float t, murk_counters *count, double y[3])
 {
+    count->collisions++;
     float dens = m->base.host->density(m->base.d->density, murk_madd(ray->o, ray->d, t));
     for (int c = 0; c < 3; c++)
         y[c] = 1.0 - (double)dens * m->base.sigma_t.c[c] / p->mu;
@@ -104,7 +108,8 @@ static void add_mean(int K, const double y[3], double (*mk)[3])
 /* One chunk's estimate into T (multiplied in). Returns 0 if rouletted or the point cap was hit. A chunk
  * deeper than 64 (Poisson weights out of double range) is ratio-tracked, with Russian roulette on its
  * product as murk_ratio_tracking. */
-static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, double tau, murk_rng *rng, double T[3])
+static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, double tau, murk_counters *count,
+                 murk_rng *rng, double T[3])
 {
     double mk[MAX_POINTS + 1][3], prod[3] = {1.0, 1.0, 1.0}, y[3];
     int K = 0, k0 = 0, ratio = tau > 64.0;
@@ -128,7 +133,7 @@ static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, doubl
                                         m->base.d->name, MAX_POINTS);
                 return 0;
             }
-            point_y(m, ray, &pc[i], t, y);
+            point_y(m, ray, &pc[i], t, count, y);
             if (!ratio) {
                 add_mean(++K, y, mk);
                 continue;
@@ -161,7 +166,7 @@ static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, doubl
         float t = pc[i].ta + (float)(u / pc[i].mu);
         if (!(t < pc[i].tb))
             t = nextafterf(pc[i].tb, pc[i].ta);
-        point_y(m, ray, &pc[i], t, y);
+        point_y(m, ray, &pc[i], t, count, y);
         add_mean(++K, y, mk);
     }
     /* N = max(K, k0) points: P(N >= k) = 1 up to k0, the Poisson tail above */
@@ -181,9 +186,10 @@ static int chunk(const ps *m, const murk_ray *ray, const piece *pc, int n, doubl
 
 /* Closes the current chunk: its estimate into T, then Russian roulette on small T. Returns 0 when
  * the estimate is 0 (rouletted or the point cap hit). */
-static int flush(const ps *m, const murk_ray *ray, const piece *pc, int *n, double *tau, murk_rng *rng, double T[3])
+static int flush(const ps *m, const murk_ray *ray, const piece *pc, int *n, double *tau, murk_counters *count,
+                 murk_rng *rng, double T[3])
 {
-    int ok = chunk(m, ray, pc, *n, *tau, rng, T);
+    int ok = chunk(m, ray, pc, *n, *tau, count, rng, T);
     *n = 0;
     *tau = 0.0;
     if (!ok)
@@ -207,6 +213,7 @@ static murk_rgb ps_estimate(const void *self, const murk_ray *ray, const murk_pa
     double T[3] = {1.0, 1.0, 1.0}, tau = 0.0;
     if (!(smax > 0.0))
         return murk_rgb1(1.0f);
+    murk_counters scratch, *count = murk_tracker_counters(h, m->base.d, &scratch);
     murk_majorant_walk w;
     h->walk_init(m->base.d->density, ray, ray->tmin, ray->tmax, &w);
     piece pc[MAX_PIECES];
@@ -227,7 +234,7 @@ static murk_rgb ps_estimate(const void *self, const murk_ray *ray, const murk_pa
                 float tc = (float)(ta + room / mu);
                 if (!(tc > ta)) { /* the room is below half a float step at ta */
                     if (n > 0) { /* the chunk is full (a cut rounded down by < mu ulp(ta) / 2) */
-                        if (!flush(m, ray, pc, &n, &tau, rng, T))
+                        if (!flush(m, ray, pc, &n, &tau, count, rng, T))
                             return murk_rgb1(0.0f);
                         continue;
                     }
@@ -239,11 +246,11 @@ static murk_rgb ps_estimate(const void *self, const murk_ray *ray, const murk_pa
             pc[n++] = (piece){ta, cut, mu};
             tau += (double)mu * ((double)cut - ta);
             ta = cut; /* cut > ta: the loop advances */
-            if ((n == MAX_PIECES || tau >= full) && !flush(m, ray, pc, &n, &tau, rng, T))
+            if ((n == MAX_PIECES || tau >= full) && !flush(m, ray, pc, &n, &tau, count, rng, T))
                 return murk_rgb1(0.0f);
         }
     }
-    if (n > 0 && !flush(m, ray, pc, &n, &tau, rng, T))
+    if (n > 0 && !flush(m, ray, pc, &n, &tau, count, rng, T))
         return murk_rgb1(0.0f);
     return murk_rgb3((float)T[0], (float)T[1], (float)T[2]);
 }

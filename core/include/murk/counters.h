@@ -5,9 +5,16 @@
  * them in the EXR (`murk:counters`). What counts what:
  *   lookups, cells   the core, in host->density() and host->walk_next(): every tracker and estimator
  *                    that reads the density through the host is counted, whatever its code;
- *   collisions       the tracker: murk/tracking.h's helpers (murk_collisions_next, murk_ratio_tracking)
- *                    count theirs; a tracker that draws collisions itself adds one per tentative
- *                    (null or real) collision to murk_tracker_counters()->collisions;
+ *   collisions       the tracker or transmittance estimator: murk/tracking.h's helpers
+ *                    (murk_collisions_next, murk_ratio_tracking) count theirs; one that draws collision
+ *                    points itself adds one per tentative (null or real) collision to
+ *                    murk_tracker_counters()->collisions. A tentative collision is a point drawn at
+ *                    random along the ray (a Poisson process of the majorant, or points of its density)
+ *                    where the density is then read or a collision is decided: decomposition's control
+ *                    collisions (no lookup) and residual ones, every point of power_series' series
+ *                    (Poisson or top-up: collisions = lookups). Ray marchers (raymarch,
+ *                    unbiased_raymarch) read the density at the points of a jittered lattice and decide
+ *                    no collision: they count none, only lookups;
  *   scatters, shadow the core, around every medium's sample() (flights that ended in a real scattering
  *                    event) and transmittance estimate (shadow-ray segments).
  * Rays traced (intersect + occluded) are counted per render, not per medium (murk_render_result.rays). */

@@ -11,7 +11,8 @@
  * host->density() and host->walk_next(), so a tracker that walks the grid itself has its lookups and
  * cells counted with nothing to do; the helpers below count their tentative collisions. A tracker that
  * draws its own collisions takes murk_tracker_counters() once per flight and adds one to ->collisions
- * per tentative (null or real) collision (decomposition.c does). */
+ * per tentative (null or real) collision (decomposition.c and power_series.c do; see murk/counters.h for
+ * what counts as one). */
 #ifndef MURK_TRACKING_H
 #define MURK_TRACKING_H
 
