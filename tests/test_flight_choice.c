@@ -34,9 +34,10 @@
  *                   makes the se small enough to see a first flight 5% short, which test_flight.c's
  *                   images do not on the cloud: with the stratified first draw x 0.95 in
  *                   murk_collisions_next, the trackers that use it failed with max |z| 7-14 per ray on
- *                   the cloud, 95-111 on the grid, 457-536 on the plateau; in murk_flight_exp,
- *                   decomposition 18-22 on the grid, 80-172 on the plateau (on the cloud its slot only
- *                   draws the first residual distance in the first non-empty cell: |z| < 1.4); in
+ *                   the cloud, 95-111 on the grid, 457-536 on the plateau; in decomposition_depth,
+ *                   decomposition 5.3-10.6 on the cloud, 42-51 on the grid, 339-414 on the plateau
+ *                   (before decomposition carried its first number over cells, its slot drew only the
+ *                   first residual distance in the cloud's first non-empty cell: |z| < 1.4); in
  *                   spectral_mis's closed form, closed_form: true 429-470 on the plateau. Every other
  *                   figure stayed within |z| 2.4. */
 #include "testutil.h"

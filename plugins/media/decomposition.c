@@ -15,8 +15,12 @@
  *
  * The medium's common keys are read by the core. With stratify_flights (murk/tracking.h) the flight's
  * first draw takes the sampler slot's first coordinate — the control distance of the first cell with a
- * control, else that cell's first residual distance (not carried over cells as murk_collisions' is) —
- * and the first residual collision's real/null choice its second.
+ * control, else that cell's first residual distance — and the first residual collision's real/null
+ * choice its second. With sobol that first number is carried over cells as murk_collisions carries it:
+ * while the process it started (control or residual) has not fired, the optical depth it has left at a
+ * cell's end starts that process in the next cell where it has a rate, instead of a new number (the
+ * inverse CDF of one exponential over the piecewise-constant rate: the same flight distribution, but
+ * its stratification reaches past the cloud's empty border cells).
  *
  * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
  * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
@@ -86,6 +90,24 @@ static void decomposition_rates(const decomposition *m, float dmax, float dmin, 
     *mu_r = murk_maxf(fabsf(r), 1e-3f * murk_maxf(dmax * m->base.smax, *rate_c)) * boost;
 }
 
+/* A process's next optical depth -ln(1 - u): what *carried holds (from an earlier cell; then -1), else a
+ * new number (the slot's while *first). *keep gets the depth when it is one to carry on at the cell's end
+ * (the slot's first number with sobol, or a carried one), else 0. */
+static float decomposition_depth(murk_rng *rng, int *first, float *uc, float *carried, float *keep)
+{
+    float tau;
+    int carry = *carried >= 0.0f;
+    if (carry) {
+        tau = *carried;
+        *carried = -1.0f;
+    } else {
+        carry = *first && rng->sampler == MURK_SAMPLER_SOBOL;
+        tau = -log1pf(-murk_flight_float(rng, first, uc));
+    }
+    *keep = carry ? murk_maxf(tau, 1e-30f) : 0.0f;
+    return tau;
+}
+
 static void decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
                                  murk_medium_event *ev)
 {
@@ -102,6 +124,9 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     float ta, tb, dmax, dmin, cscale = 1.0f, boost = 1.0f;
     int first = murk_flight_stratified(d); /* the flight's first numbers from the sampler (murk/tracking.h) */
     float uc = -1.0f;
+    /* with sobol, the optical depth the first number has left for the process it started (control: tau_c,
+     * residual: tau_r), carried to the next cell where that process has a rate; -1: none */
+    float tau_c = -1.0f, tau_r = -1.0f;
     long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         if (++steps > MURK_WATCHDOG_ITERATIONS) {
@@ -113,16 +138,25 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
         decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
         if (!(rate_c > 0.0f) && !(mu_r > 0.0f))
             continue;
-        float tc = rate_c > 0.0f ? murk_advance(ta, murk_flight_exp(rng, &first, &uc, rate_c)) : INFINITY;
+        float tc = INFINITY, dc = 0.0f; /* dc: the optical depth tc was drawn with, if it is carried on */
+        if (rate_c > 0.0f)
+            tc = murk_advance(ta, decomposition_depth(rng, &first, &uc, &tau_c, &dc) / rate_c);
         for (float t = ta;;) {
             if (++steps > MURK_WATCHDOG_ITERATIONS) {
                 murk_tracker_watchdog(&m->base, "a free flight");
                 murk_event_kill(ev, t);
                 return;
             }
-            float tr = mu_r > 0.0f ? murk_advance(t, murk_flight_exp(rng, &first, &uc, mu_r)) : INFINITY;
-            if (!(tc < tb) && !(tr < tb))
+            float tr = INFINITY, dr = 0.0f;
+            if (mu_r > 0.0f)
+                tr = murk_advance(t, decomposition_depth(rng, &first, &uc, &tau_r, &dr) / mu_r);
+            if (!(tc < tb) && !(tr < tb)) { /* the cell passed: what a carried number has left goes on */
+                if (dc > 0.0f)
+                    tau_c = murk_maxf(0.0f, dc - rate_c * (tb - ta));
+                if (dr > 0.0f)
+                    tau_r = murk_maxf(0.0f, dr - mu_r * (tb - t));
                 break;
+            }
             count->collisions++; /* a control or a residual collision */
             if (tc <= tr) { /* control collision */
                 for (int k = 0; k < 3; k++)
@@ -167,6 +201,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
                     boost = murk_minf(boost * MURK_MAJORANT_RAISE * amax, 1e12f);
                 decomposition_rates(m, dmax, dmin, cscale, boost, &rate_c, &mu_r);
                 tc = rate_c > 0.0f ? murk_advance(t, murk_sample_exp(rng, rate_c)) : INFINITY;
+                dc = 0.0f;
             }
         }
     }
