@@ -1106,10 +1106,14 @@ static int emit_jobs(const bench *b, int argc, char **argv)
     }
     bench jb = *b;
     jb.jobs = dir;
-    snprintf(path, sizeof path, "%s/jobs.txt", dir);
-    FILE *f = fopen(path, "w");
+    /* the three files as text in memory, then written as one group (atomic.h): all of them or none */
+    enum { JOBS, SLURM, ASSEMBLE, NFILES };
+    static const char *const names[NFILES] = {"jobs.txt", "slurm.sh", "assemble.sh"};
+    char *text[NFILES] = {NULL, NULL, NULL};
+    size_t len[NFILES] = {0, 0, 0};
+    FILE *f = open_memstream(&text[JOBS], &len[JOBS]);
     if (!f) {
-        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+        fprintf(stderr, "murk: out of memory\n");
         return 1;
     }
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
@@ -1137,8 +1141,7 @@ static int emit_jobs(const bench *b, int argc, char **argv)
             }
     free(sets);
     int bad = fclose(f) != 0;
-    snprintf(path, sizeof path, "%s/slurm.sh", dir);
-    if (!bad && (f = fopen(path, "w")) != NULL) {
+    if (!bad && (f = open_memstream(&text[SLURM], &len[SLURM])) != NULL) {
         fprintf(f, "#!/bin/sh\n# murk bench as a Slurm job array: one render per task (line TASK + 1 of jobs.txt).\n"
                    "#   jid=$(sbatch --parsable slurm.sh)\n"
                    "#   sbatch --dependency=afterok:$jid --wrap 'sh %s/assemble.sh'\n"
@@ -1148,8 +1151,7 @@ static int emit_jobs(const bench *b, int argc, char **argv)
     } else {
         bad = 1;
     }
-    snprintf(path, sizeof path, "%s/assemble.sh", dir);
-    if (!bad && (f = fopen(path, "w")) != NULL) {
+    if (!bad && (f = open_memstream(&text[ASSEMBLE], &len[ASSEMBLE])) != NULL) {
         char cwd[4096];
         fprintf(f, "#!/bin/sh\n# Reads the renders of jobs.txt back into bench.csv, the charts and the report: the\n"
                    "# bench's own command line, in its folder, with --assemble for --emit-jobs.\ncd");
@@ -1171,8 +1173,23 @@ static int emit_jobs(const bench *b, int argc, char **argv)
     } else {
         bad = 1;
     }
+    char err[8400] = "out of memory";
+    if (!bad) {
+        murk_output_begin();
+        for (int i = 0; i < NFILES && !bad; i++) {
+            text_job tj = {text[i], len[i]};
+            snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+            bad = murk_write_atomic(path, text_fill, &tj, err, sizeof err) != 0;
+        }
+        if (bad)
+            murk_output_abort();
+        else
+            bad = murk_output_commit(err, sizeof err) != 0;
+    }
+    for (int i = 0; i < NFILES; i++)
+        free(text[i]);
     if (bad) {
-        fprintf(stderr, "murk: cannot write %s: %s\n", murk_cli_q(path), strerror(errno));
+        fprintf(stderr, "murk: %s\n", err);
         return 1;
     }
     printf("%d renders as jobs: %s/jobs.txt (one command a line), %s/slurm.sh (sbatch: a job array); then "
