@@ -25,8 +25,10 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
+    s->nboundaries = 0;
     for (size_t i = 0; i < s->nshapes; i++) {
         murk_shape *sh = &s->shapes[i];
+        s->nboundaries += !sh->material;
         RTCGeometry g;
         if (sh->type == MURK_SHAPE_SPHERE) {
             g = rtcNewGeometry(s->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);

@@ -277,6 +277,8 @@ static murk_rgb host_background(const murk_scene *s, murk_vec3 dir)
 
 static const murk_medium *host_camera_medium(const murk_scene *s) { return s->camera_medium; }
 
+static size_t host_boundaries(const murk_scene *s) { return s->nboundaries; }
+
 static const murk_host host_table = {
     .size = sizeof(murk_host),
     .abi_major = MURK_ABI_MAJOR,
@@ -300,6 +302,7 @@ static const murk_host host_table = {
     .counters = murk_media_counters,
     .sample_light_with = murk_lights_sample,
     .light_pdf_with = murk_lights_pdf,
+    .boundaries = host_boundaries,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }

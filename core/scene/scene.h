@@ -88,6 +88,7 @@ struct murk_scene {
     /* geometry */
     murk_shape *shapes; /* index = Embree geometry id */
     size_t nshapes;
+    size_t nboundaries; /* shapes without a material: index-matched boundaries (set by murk_accel_build) */
     murk_light *lights;
     size_t nlights;
     float *light_cdf; /* nlights + 1 */

@@ -163,6 +163,8 @@ murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p,
         r.tmax = len - end_eps;
         if (!m && !h->occluded(scene, &r)) /* nothing at all in the way: the common case, cheaply */
             return T;
+        if (!m && !h->boundaries(scene)) /* in the way, and without boundaries it is an occluder */
+            return murk_rgb1(0.0f);
         murk_hit hit;
         int found = h->intersect(scene, &r, &hit);
         if (found && hit.material)

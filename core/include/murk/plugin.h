@@ -25,7 +25,8 @@
  * kind and murk_medium's estimator fields; 1.3 appends murk_bsdf_sample.eta and lets materials transmit
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
- * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h).
+ * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h);
+ * 1.6 appends murk_host.boundaries.
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -57,7 +58,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 5
+#define MURK_ABI_MINOR 6
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
@@ -185,6 +186,10 @@ typedef struct murk_host {
     int (*sample_light_with)(const murk_scene *scene, murk_vec3 p, const float u[3], int strategy,
                              murk_light_sample *ls);
     float (*light_pdf_with)(const murk_scene *scene, murk_vec3 p, const murk_hit *hit, int strategy);
+    /* ABI 1.6: how many index-matched boundaries (shapes without a material) the scene has. With none,
+     * every surface occluded() can find has a material: a shadow ray it reports blocked is blocked,
+     * with no intersect() to tell a boundary from an occluder. */
+    size_t (*boundaries)(const murk_scene *scene);
 } murk_host;
 
 /* Light sampling strategies (ABI 1.4). AREA: a triangle (quads and box faces are two) uniformly by
