@@ -14,6 +14,9 @@
  *               Two independent estimators of the same image: block-wise z-test (img_stack_agree).
  *   path        `path` (surfaces only) with an index-matched box in the room renders what it renders
  *               without the box: its paths pass boundaries, and so must its shadow rays.
+ *   shadow_once a scene without boundaries (host->boundaries() 0) ends a shadow ray that occluded()
+ *               reports blocked without tracing it again: the Cornell box renders bitwise what it
+ *               renders with an index-matched box out of every ray's reach added, with fewer rays.
  *
  * Both failed before the fix of shadow rays that restarted off their line after a boundary and hit
  * the lamp itself (and of `path`'s shadow rays that stopped at boundaries). test_boundaries_long.c
@@ -289,6 +292,45 @@ static void test_path(void **state)
     assert_true(ok);
 }
 
+/* The rays a render traced, from murk's "counters: N rays traced" line. */
+static unsigned long long rays_traced(const char *scene, const char *out)
+{
+    char *log = NULL;
+    const char *args[] = {"render", scene, "-o", out, "--spp", "2", "--threads", "2", "--set",
+                          "render.resolution=[48,48]", NULL};
+    int rc = run_murk_argv(&log, args);
+    const char *at = log ? strstr(log, "counters: ") : NULL;
+    unsigned long long n = 0;
+    if (rc != 0 || !at || sscanf(at, "counters: %llu rays traced", &n) != 1)
+        fail_msg("murk render %s (%d) printed no ray count:\n%s", scene, rc, log ? log : "");
+    free(log);
+    return n;
+}
+
+static void test_shadow_once(void **state)
+{
+    (void)state;
+    FILE *f = fopen(src_path("scenes/cornell.yaml"), "rb");
+    assert_non_null(f);
+    char text[8192];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = 0;
+    char *shapes = strstr(text, "shapes:\n");
+    assert_non_null(shapes);
+    /* a medium and its index-matched box far below the room, outside the camera's view: no ray meets it */
+    char with[9000];
+    snprintf(with, sizeof with, "%.*smedia:\n  fog: { type: delta, density: { constant: 1 }, sigma_a: [0.1, 0.1, 0.1], "
+             "sigma_s: [0.1, 0.1, 0.1] }\n%s  - { type: box, min: [-1, -60, -3], max: [1, -50, -2], interior: fog }\n",
+             (int)(shapes - text), text, shapes);
+    unsigned long long plain = rays_traced(src_path("scenes/cornell.yaml"), tmp_path("once_plain.exr"));
+    unsigned long long bounded = rays_traced(write_tmp("once_boundary.yaml", with), tmp_path("once_boundary.exr"));
+    printf("cornell, 48x48, 2 spp: %llu rays without a boundary, %llu with one out of reach (%.1f %% fewer)\n",
+           plain, bounded, 100.0 * (1.0 - (double)plain / (double)bounded));
+    assert_same_pixels(tmp_path("once_plain.exr"), tmp_path("once_boundary.exr"));
+    assert_true(plain < bounded);
+}
+
 #ifndef BOUNDARIES_NO_MAIN
 int main(int argc, char **argv)
 {
@@ -299,6 +341,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_shadow),
         cmocka_unit_test(test_nee),
         cmocka_unit_test(test_path),
+        cmocka_unit_test(test_shadow_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

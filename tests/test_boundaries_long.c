@@ -23,6 +23,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_nee),
         cmocka_unit_test(test_shadow), /* as in the default run */
         cmocka_unit_test(test_path),   /* as in the default run */
+        cmocka_unit_test(test_shadow_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
