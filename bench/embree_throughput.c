@@ -3,29 +3,39 @@
  *
  *   build/bench/embree_throughput [scene.yaml] [seconds-per-side-per-round] [rounds] [surfaces]
  *
- * (`surfaces`: leave the media figure out.) Three sides, each run for the given CPU seconds per round:
+ * (`surfaces`: leave the media figure out.) Three sides, and on a scene of diffuse triangles (no media,
+ * boundaries, spheres or shading normals) the bare tracer's five rungs, each run for the given CPU
+ * seconds per round:
  *   raw     random incoherent rays — origins uniform in the scene's bounding box, directions uniform on
  *           the sphere — through rtcIntersect1 alone (the yardstick of "murk reaches X % of raw Embree");
  *   replay  the rays murk itself traced in a 4-spp render of the scene (recorded by host.c,
  *           murk_host_record_rays), traced again in the same order with the same calls: rtcIntersect1
  *           for camera, BSDF and boundary rays, rtcOccluded1 for shadow rays, a fresh context per ray as
  *           host.c makes it;
+ *   bare    `path`'s algorithm (NEE by area with the power heuristic, cosine sampling, murk's roulette
+ *           and slots) written straight against Embree, with nothing of murk's layers (bare_li): what a
+ *           renderer without plugins reaches on this yardstick, with the scene's sampler (`bare`) and
+ *           with independent numbers (`bare-pcg`); then the rungs towards murk, each adding one layer
+ *           to the one before: `+host rays` (the host table's intersect() / occluded(), murk_hit),
+ *           `+host lights` (sample_light_with() / light_pdf_with()), `+materials` (the material
+ *           plugin's eval / pdf / sample in the shading frame). Each rung's image mean is printed
+ *           beside murk's: they estimate the same image;
  *   murk    `murk render` with the scene's integrator at --threads 1 (camera rays, NEE shadow rays, BSDF
  *           rays, shading, sampling, film), its rays counted as murk counts them.
  * The Embree sides generate or convert their rays outside the timed part; the murk side times everything
  * murk does (per render too: thread start, film, under 1 ms of a 1-s side).
  *
  * The machine's speed drifts (shared, turbo, neighbours), so the sides are measured in several short
- * interleaved rounds — raw, replay, murk, then murk, replay, raw, ... — each round gives one ratio per
- * pair, and the median ratio is quoted with its spread (min and max over the rounds). Defaults: 1 s,
- * 9 rounds. Every side is timed in CPU seconds, not wall time, which on a shared machine counts the
+ * interleaved rounds — raw, replay, the rungs, murk, then the same in reverse, ... — each round gives one
+ * ratio per pair, and the median ratio is quoted with its spread (min and max over the rounds).
+ * Defaults: 1 s, 9 rounds. Every side is timed in CPU seconds, not wall time, which on a shared machine counts the
  * other processes' time slices too: the Embree sides in the thread's (CLOCK_THREAD_CPUTIME_ID), murk in
  * the process's (CLOCK_PROCESS_CPUTIME_ID: its one render thread works while the main thread waits).
  *
  * Is it fair? Rays are counted the same way on every side: one Embree call, one ray. murk's path tracer
- * makes an occlusion query per shadow ray and, when it reports a hit, an intersection along the same
- * segment to tell a surface from an index-matched boundary; both are rays, counted once each by murk and
- * replayed once each. But murk's rays are cheaper for Embree than the raw side's — its camera rays are
+ * makes an occlusion query per shadow ray and, when it reports a hit in a scene with index-matched
+ * boundaries, an intersection along the same segment to tell a surface from a boundary; both are rays,
+ * counted once each by murk and replayed once each. But murk's rays are cheaper for Embree than the raw side's — its camera rays are
  * coherent and a third of its calls are occlusion queries cut at the light — so the replay runs about
  * 1.4x as many rays per second as the raw side on the Cornell box, and murk / raw flatters murk by that
  * much. murk / replay is the like-for-like ratio (the same Embree work on both sides); it is also the
@@ -40,6 +50,7 @@
  * end at the same t), so the ratio of flights/s is the ratio of tracker steps/s; the bare loop's steps
  * (tentative collisions + majorant cells) per second are printed too. Interleaved rounds as above, timed
  * in the thread's CPU seconds (CLOCK_THREAD_CPUTIME_ID). */
+#include "camera.h"
 #include "host.h"
 #include "scene.h"
 #include "util.h"
@@ -183,8 +194,18 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* "median M %, spread A .. B %" of n ratios (sorts them); a static buffer. */
+static const char *median_spread(double *r, int n)
+{
+    static char buf[96];
+    qsort(r, (size_t)n, sizeof *r, cmp_double);
+    double median = n % 2 ? r[n / 2] : 0.5 * (r[n / 2 - 1] + r[n / 2]);
+    snprintf(buf, sizeof buf, "median %.1f %%, spread %.1f .. %.1f %%", 100.0 * median, 100.0 * r[0], 100.0 * r[n - 1]);
+    return buf;
+}
+
 /* murk's rays/s over one time-limited render of the scene. */
-static double murk_side(murk_scene *s, double seconds, int *spp)
+static double murk_side(murk_scene *s, double seconds, int *spp, double *mean)
 {
     murk_render_opts o = {.threads = 1, .time_limit = seconds};
     murk_render_result r;
@@ -192,8 +213,266 @@ static double murk_side(murk_scene *s, double seconds, int *spp)
     murk_render(s, &o, &r);
     double rps = (double)r.rays / (proc_cpu_now() - t0);
     *spp = r.spp;
+    double sum = 0.0;
+    for (size_t i = 0; i < 3 * (size_t)s->width * (size_t)s->height; i++)
+        sum += r.rgb[i];
+    *mean = sum / (3.0 * s->width * s->height);
     free(r.rgb);
     return rps;
+}
+
+/* ---- a bare path tracer: what a renderer without murk's layers reaches on this yardstick ---------
+ * The `path` integrator's algorithm on a scene of diffuse triangles, written straight against Embree:
+ * camera ray (murk_camera_sample), rtcIntersect1 / rtcOccluded1 called here, the hit point o + t d and the
+ * triangle's stored normal, the albedo read once per shape before timing (the material's eval at normal
+ * incidence, times pi), NEE by area with the power heuristic against cosine sampling, emission weighted
+ * the same way, murk's Russian roulette (after 3 events, q = max(beta) clamped to [0.05, 1]), max depth
+ * 64. No plugin calls, no murk_hit, no NaN checks, no boundaries, no media. Its numbers come from murk's
+ * sampler: `bare` with the scene's (sobol), `bare-pcg` with independent numbers. Its image agrees with
+ * murk's in expectation (the mean of both renders is printed). Rays counted per Embree call, as murk's. */
+typedef struct bare_pt {
+    const murk_scene *s;
+    murk_rgb *albedo; /* per shape */
+} bare_pt;
+
+static int bare_supported(const murk_scene *s, murk_rgb **albedo)
+{
+    if (s->nmedia || s->nboundaries || s->camera_medium)
+        return 0;
+    for (size_t i = 0; i < s->nmaterials; i++)
+        if (strcmp(s->materials[i].plugin->desc->name, "diffuse") != 0)
+            return 0;
+    *albedo = murk_xmalloc(s->nshapes * sizeof **albedo);
+    for (size_t i = 0; i < s->nshapes; i++) {
+        const murk_shape *sh = &s->shapes[i];
+        if (sh->type == MURK_SHAPE_SPHERE || !sh->material || sh->nrm)
+            return free(*albedo), 0;
+        murk_hit h = {0};
+        h.n = h.ng = murk_v3(0, 0, 1);
+        h.material = sh->material;
+        murk_vec3 z = murk_v3(0, 0, 1);
+        (*albedo)[i] = murk_rgb_scale(sh->material->vt->eval(sh->material->self, &h, z, z), MURK_PI);
+    }
+    return 1;
+}
+
+static float bare_power(float a, float b) { return a * a / (a * a + b * b); }
+
+static murk_vec3 bare_offset(murk_vec3 p, murk_vec3 n)
+{
+    float m = murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z)));
+    return murk_madd(p, n, 1e-4f * murk_maxf(1.0f, m));
+}
+
+/* The rungs of the ladder from the bare tracer towards murk, each adding one of murk's layers to the one
+ * before (all with the scene's sampler; BARE_PCG is BARE with independent numbers). */
+enum { BARE_PCG, BARE, BARE_HOST_RAYS, BARE_HOST_LIGHTS, BARE_MATERIALS, BARE_RUNGS };
+static const char *const bare_rung_name[BARE_RUNGS] = {"bare-pcg", "bare", "+host rays", "+host lights", "+materials"};
+
+#if defined(__GNUC__)
+#define BARE_INLINE inline __attribute__((always_inline))
+#else
+#define BARE_INLINE inline
+#endif
+
+/* One sample of the bare tracer at rung `rung` (a constant where it is called, so each rung is compiled
+ * without the others' branches):
+ *   BARE              rtcIntersect1 / rtcOccluded1 called here, the triangle's stored normal, o + t d,
+ *                     the light chosen and sampled here, the diffuse BSDF written out;
+ *   BARE_HOST_RAYS    rays through the host table's intersect() / occluded() (murk_hit filled, ray checks);
+ *   BARE_HOST_LIGHTS  and NEE and the emission's MIS pdf through sample_light_with() / light_pdf_with();
+ *   BARE_MATERIALS    and the BSDF through the material plugin (eval, pdf, sample in the shading frame,
+ *                     on a copy of the hit), as pathtracer.c calls it.
+ * What is left between the last rung and murk is pathtracer.c's generality (boundaries, media, delta
+ * lobes, NaN checks, the lobe and hero slots) and render.c's loop (tiles, film). */
+static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *rng, uint64_t *rays, int rung)
+{
+    const murk_scene *s = bt->s;
+    const murk_host *h = murk_host_table();
+    murk_rgb L = murk_rgb1(0.0f), beta = murk_rgb1(1.0f);
+    struct RTCRayHit rh;
+    murk_hit hit;
+    murk_vec3 o = cam.o, d = cam.d, prev_p = cam.o;
+    float prev_pdf = 0.0f;
+    int prev_cam = 1;
+    for (int depth = 0;; depth++) {
+        murk_vec3 ng, p;
+        float t;
+        const murk_shape *sh;
+        if (rung >= BARE_HOST_RAYS) {
+            murk_ray r = {o, d, 0.0f, INFINITY};
+            ++*rays;
+            if (!h->intersect(s, &r, &hit)) {
+                L = murk_rgb_add(L, murk_rgb_mul(beta, s->background));
+                break;
+            }
+            sh = &s->shapes[hit.geom];
+            ng = hit.ng, p = hit.p, t = hit.t;
+        } else {
+            struct RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
+            rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+            rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(s->rtc, &ctx, &rh);
+            ++*rays;
+            if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+                L = murk_rgb_add(L, murk_rgb_mul(beta, s->background));
+                break;
+            }
+            sh = &s->shapes[rh.hit.geomID];
+            const float *ngp = &sh->ng[3 * rh.hit.primID];
+            ng = murk_v3(ngp[0], ngp[1], ngp[2]), t = rh.ray.tfar, p = murk_madd(o, d, t);
+        }
+        float cos_o = -murk_dot(ng, d);
+        if (sh->light_base >= 0 && cos_o > 0.0f) { /* emission, MIS-weighted against the NEE that could find it */
+            float w = 1.0f;
+            if (!prev_cam) {
+                float lpdf;
+                if (rung >= BARE_HOST_LIGHTS) {
+                    lpdf = h->light_pdf_with(s, prev_p, &hit, MURK_LIGHT_AREA);
+                } else {
+                    const murk_light *l = &s->lights[sh->light_base + (int32_t)(rung >= BARE_HOST_RAYS ? hit.prim : rh.hit.primID)];
+                    lpdf = l->pmf * t * t / (cos_o * l->area);
+                }
+                w = bare_power(prev_pdf, lpdf);
+            }
+            L = murk_rgb_add(L, murk_rgb_scale(murk_rgb_mul(beta, sh->emission), w));
+        }
+        if (depth >= 64)
+            break;
+        murk_vec3 n = cos_o >= 0.0f ? ng : murk_neg(ng), tt, bb;
+        murk_basis(n, &tt, &bb);
+        murk_hit mh; /* the material's copy (BARE_MATERIALS) */
+        if (rung >= BARE_MATERIALS)
+            mh = hit, mh.n = n;
+        murk_rgb albedo = bt->albedo[sh - s->shapes], f = murk_rgb_scale(albedo, MURK_INV_PI);
+        murk_vec3 po = bare_offset(p, n), wo_local = murk_to_local(murk_neg(d), tt, bb, n);
+        float u[3];
+        murk_sample_seek(rng, 2u + (uint32_t)depth * 5u); /* the slots `path` uses (pathtracer.c) */
+        u[0] = murk_sample_1d(rng);
+        murk_sample_2d(rng, u + 1);
+        murk_vec3 wi, q;
+        float lpdf, dist, cosi = 0.0f;
+        murk_rgb le = murk_rgb1(0.0f);
+        int lit = 0;
+        if (rung >= BARE_HOST_LIGHTS) {
+            murk_light_sample ls;
+            if (h->sample_light_with(s, p, u, MURK_LIGHT_AREA, &ls)) {
+                wi = ls.wi, lpdf = ls.pdf, dist = ls.dist, le = ls.le, q = murk_madd(p, wi, dist);
+                cosi = murk_dot(n, wi);
+                lit = cosi > 0.0f;
+            }
+        } else if (s->nlights) { /* a light triangle by power, a point on it by area */
+            size_t lo = 0, len = s->nlights;
+            while (len > 1) {
+                size_t half = len / 2;
+                lo = s->light_cdf[lo + half] <= u[0] ? lo + half : lo;
+                len -= half;
+            }
+            const murk_light *l = &s->lights[lo];
+            float su = sqrtf(u[1]);
+            q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+            murk_vec3 dl = murk_sub(q, po);
+            float dist2 = murk_dot(dl, dl);
+            dist = sqrtf(dist2);
+            wi = murk_mul(dl, 1.0f / dist);
+            float cosl = -murk_dot(l->n, wi);
+            cosi = murk_dot(n, wi);
+            lpdf = l->pmf * dist2 / (cosl * l->area);
+            le = l->le;
+            lit = cosl > 0.0f && cosi > 0.0f;
+        }
+        if (lit) {
+            murk_rgb fl = f;
+            float bpdf = cosi * MURK_INV_PI;
+            if (rung >= BARE_MATERIALS) {
+                murk_vec3 wl = murk_to_local(wi, tt, bb, n);
+                fl = sh->material->vt->eval(sh->material->self, &mh, wo_local, wl);
+                bpdf = sh->material->vt->pdf(sh->material->self, &mh, wo_local, wl);
+            }
+            float end = 1e-4f * murk_maxf(1.0f, murk_maxf(fabsf(q.x), murk_maxf(fabsf(q.y), fabsf(q.z))));
+            murk_vec3 dl = murk_sub(q, po);
+            float len = murk_length(dl);
+            int blocked;
+            ++*rays;
+            if (rung >= BARE_HOST_RAYS) {
+                murk_ray sr = {po, murk_mul(dl, 1.0f / len), 0.0f, len - end};
+                blocked = h->occluded(s, &sr);
+            } else {
+                struct RTCIntersectContext ctx;
+                struct RTCRay sr = {po.x, po.y, po.z, 0.0f, wi.x, wi.y, wi.z, 0.0f, dist - end, ~0u, 0, 0};
+                rtcInitIntersectContext(&ctx);
+                rtcOccluded1(s->rtc, &ctx, &sr);
+                blocked = sr.tfar < 0.0f;
+            }
+            if (!blocked)
+                L = murk_rgb_add(L, murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(beta, fl), le), cosi * bare_power(lpdf, bpdf) / lpdf));
+        }
+        murk_sample_seek(rng, 2u + (uint32_t)depth * 5u + 2u);
+        murk_sample_2d(rng, u);
+        if (rung >= BARE_MATERIALS) {
+            murk_bsdf_sample bs;
+            u[2] = 0.5f;
+            if (!sh->material->vt->sample(sh->material->self, &mh, wo_local, u, &bs) || !(bs.pdf > 0.0f))
+                break;
+            d = murk_from_local(bs.wi, tt, bb, n);
+            prev_pdf = bs.pdf;
+            beta = murk_rgb_mul(beta, murk_rgb_scale(bs.f, fabsf(bs.wi.z) / bs.pdf));
+        } else {
+            float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1], x = r * cosf(phi), y = r * sinf(phi);
+            float z = sqrtf(murk_maxf(0.0f, 1.0f - x * x - y * y));
+            if (z <= 0.0f)
+                break;
+            d = murk_from_local(murk_v3(x, y, z), tt, bb, n);
+            prev_pdf = z * MURK_INV_PI;
+            beta = murk_rgb_mul(beta, albedo); /* f cos / pdf */
+        }
+        o = po;
+        prev_p = p;
+        prev_cam = 0;
+        if (depth + 1 > 3) {
+            float qq = murk_maxf(0.05f, murk_minf(1.0f, murk_maxf(beta.c[0], murk_maxf(beta.c[1], beta.c[2]))));
+            murk_sample_seek(rng, 2u + (uint32_t)depth * 5u + 4u);
+            if (murk_sample_1d(rng) >= qq)
+                break;
+            beta = murk_rgb_scale(beta, 1.0f / qq);
+        }
+    }
+    return L;
+}
+
+/* Rung `rung`'s rays/s over whole 128x128 passes for about `seconds`; *mean gets its image's mean (over
+ * the passes, all channels). */
+static double bare_pt_side(const bare_pt *bt, int rung, double seconds, double *mean)
+{
+    const murk_scene *s = bt->s;
+    uint64_t rays = 0, k = 0;
+    double sum = 0.0, el, t0 = cpu_now();
+    murk_scene tmp = *s; /* murk_camera_sample takes the sampler from the scene */
+    tmp.sampler = rung == BARE_PCG ? MURK_SAMPLER_INDEPENDENT : s->sampler;
+    do {
+        for (int y = 0; y < s->height; y++)
+            for (int x = 0; x < s->width; x++) {
+                murk_rng rng;
+                murk_ray cam;
+                murk_rgb c;
+                murk_camera_sample(&tmp, x, y, (uint32_t)k, &rng, &cam);
+                switch (rung) { /* constant rungs: bare_li is compiled once for each */
+                case BARE_PCG:
+                case BARE: c = bare_li(bt, cam, &rng, &rays, BARE); break;
+                case BARE_HOST_RAYS: c = bare_li(bt, cam, &rng, &rays, BARE_HOST_RAYS); break;
+                case BARE_HOST_LIGHTS: c = bare_li(bt, cam, &rng, &rays, BARE_HOST_LIGHTS); break;
+                default: c = bare_li(bt, cam, &rng, &rays, BARE_MATERIALS); break;
+                }
+                sum += (double)c.c[0] + c.c[1] + c.c[2];
+            }
+        k++;
+        el = cpu_now() - t0;
+    } while (el < seconds);
+    *mean = sum / (3.0 * (double)k * s->width * s->height);
+    return (double)rays / el;
 }
 
 /* ---- media: tracker against a bare loop over the same majorant grid ------------------------------ */
@@ -359,34 +638,54 @@ int main(int argc, char **argv)
     printf("scene %s (128x128), one thread each, %d rounds of %.1f s per side, order alternating\n"
            "replay: the %zu rays (%.0f %% occlusion queries) of a 4-spp render of it by murk, traced again by Embree alone\n",
            path, rounds, seconds, rp.n, 100.0 * (double)count_occluded(&rp) / (double)rp.n);
-    printf("round  raw Mrays/s  replay Mrays/s  murk Mrays/s  murk/raw  murk/replay\n");
-    double *ratio = murk_xmalloc(2 * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds;
+    bare_pt bt = {s, NULL};
+    int bare = bare_supported(s, &bt.albedo);
+    printf("bare: %s\n", bare ? "`path`'s algorithm written straight against Embree, and the rungs towards murk (bare_li)"
+                              : "left out (the scene has media, boundaries, spheres, shading normals or non-diffuse materials)");
+    printf("round  raw Mrays/s  replay Mrays/s  murk Mrays/s  murk/raw  murk/replay");
+    for (int j = 0; bare && j < BARE_RUNGS; j++)
+        printf("  %s/raw", bare_rung_name[j]);
+    printf("\n");
+    double *ratio = murk_xmalloc((2 + BARE_RUNGS) * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds,
+           *bratio = rratio + rounds; /* bratio[j * rounds + k] */
+    double bmean[BARE_RUNGS] = {0}, mmean = 0.0;
     for (int k = 0; k < rounds; k++) {
         uint64_t nraw;
         int spp;
-        double raw, rep, mr;
-        if (k % 2 == 0) {
-            raw = raw_embree(s, seconds, &nraw);
-            rep = replay_side(s, &rp, seconds);
-            mr = murk_side(s, seconds, &spp);
-        } else {
-            mr = murk_side(s, seconds, &spp);
-            rep = replay_side(s, &rp, seconds);
-            raw = raw_embree(s, seconds, &nraw);
+        double raw = 0.0, rep = 0.0, mr = 0.0, br[BARE_RUNGS] = {0}, m;
+        /* the sides in turn, the order reversed every other round: raw, replay, bare rungs, murk */
+        for (int i = 0; i < 3 + BARE_RUNGS; i++) {
+            int side = k % 2 == 0 ? i : 2 + BARE_RUNGS - i;
+            if (side == 0)
+                raw = raw_embree(s, seconds, &nraw);
+            else if (side == 1)
+                rep = replay_side(s, &rp, seconds);
+            else if (side == 2 + BARE_RUNGS)
+                mr = murk_side(s, seconds, &spp, &m), mmean += m / rounds;
+            else if (bare)
+                br[side - 2] = bare_pt_side(&bt, side - 2, seconds, &m), bmean[side - 2] += m / rounds;
         }
         ratio[k] = mr / raw;
         rratio[k] = mr / rep;
-        printf("%5d  %11.2f  %14.2f  %12.2f  %6.1f %%  %9.1f %%\n", k + 1, raw / 1e6, rep / 1e6, mr / 1e6, 100.0 * ratio[k],
+        printf("%5d  %11.2f  %14.2f  %12.2f  %6.1f %%  %9.1f %%", k + 1, raw / 1e6, rep / 1e6, mr / 1e6, 100.0 * ratio[k],
                100.0 * rratio[k]);
+        for (int j = 0; bare && j < BARE_RUNGS; j++) {
+            bratio[j * rounds + k] = br[j] / raw;
+            printf("  %*.1f %%", (int)strlen(bare_rung_name[j]) + 2, 100.0 * bratio[j * rounds + k]);
+        }
+        printf("\n");
     }
-    qsort(ratio, (size_t)rounds, sizeof *ratio, cmp_double);
-    qsort(rratio, (size_t)rounds, sizeof *rratio, cmp_double);
-    double median = rounds % 2 ? ratio[rounds / 2] : 0.5 * (ratio[rounds / 2 - 1] + ratio[rounds / 2]);
-    double rmedian = rounds % 2 ? rratio[rounds / 2] : 0.5 * (rratio[rounds / 2 - 1] + rratio[rounds / 2]);
-    printf("murk / raw Embree (%s integrator): median %.1f %%, spread %.1f .. %.1f %%\n",
-           s->integrator_plugin->desc->name, 100.0 * median, 100.0 * ratio[0], 100.0 * ratio[rounds - 1]);
-    printf("murk / replay of its own rays (Embree's share of murk's time): median %.1f %%, spread %.1f .. %.1f %%\n",
-           100.0 * rmedian, 100.0 * rratio[0], 100.0 * rratio[rounds - 1]);
+    printf("murk / raw Embree (%s integrator): %s\n", s->integrator_plugin->desc->name, median_spread(ratio, rounds));
+    printf("murk / replay of its own rays (Embree's share of murk's time): %s\n", median_spread(rratio, rounds));
+    if (bare) {
+        for (int j = 0; j < BARE_RUNGS; j++)
+            printf("%s / raw Embree: %s\n", bare_rung_name[j], median_spread(bratio + j * rounds, rounds));
+        printf("image means (all channels, over the rounds): murk %.5f", mmean);
+        for (int j = 0; j < BARE_RUNGS; j++)
+            printf(", %s %.5f", bare_rung_name[j], bmean[j]);
+        printf("\n");
+        free(bt.albedo);
+    }
     free(rp.rh);
     free(rp.occluded);
     free(ratio);
