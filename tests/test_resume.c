@@ -1,9 +1,10 @@
-/* test_resume.c — interrupt and resume (issue 10, item 7). Renders are killed with SIGINT or SIGTERM at
+/* test_resume.c — interrupt and resume (issue 10, item 7). Renders are killed with SIGINT, SIGTERM or SIGHUP at
  * random points (during a pass, during a checkpoint or image write, before rendering starts), resumed
  * from their checkpoint, killed again, ... until they finish; the finished image must be bitwise
  * identical to an uninterrupted render of the same spp. An interrupted render must exit with 128 + the
  * signal, write the image of the spp it reached (murk:spp, murk:interrupted) or nothing, and leave no
- * temporary file behind. A checkpoint of another scene / other overrides is refused. */
+ * temporary file behind. A checkpoint of another scene / other overrides is refused. A SIGHUP that was
+ * ignored when murk started (nohup) stays ignored. */
 #include "image.h"
 #include "testutil.h"
 
@@ -30,6 +31,8 @@ static double now(void)
 }
 
 /* Starts `murk render` on the small Cornell box into dir/out with extra arguments (NULL-terminated). */
+static int ignore_hup; /* start_render's child starts murk with SIGHUP ignored, as nohup does */
+
 static pid_t start_render(const char *dir, const char *out, const char *const *extra)
 {
     const char *exe = getenv("MURK_EXE");
@@ -56,6 +59,7 @@ static pid_t start_render(const char *dir, const char *out, const char *const *e
     if (pid == 0) {
         if (chdir(dir) != 0)
             _exit(126);
+        signal(SIGHUP, ignore_hup ? SIG_IGN : SIG_DFL);
         int fd = open("/dev/null", O_WRONLY);
         if (fd >= 0) {
             dup2(fd, STDOUT_FILENO);
@@ -66,6 +70,8 @@ static pid_t start_render(const char *dir, const char *out, const char *const *e
     }
     return pid;
 }
+
+static const char *sig_name(int sig) { return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP"; }
 
 static int wait_status(pid_t pid)
 {
@@ -157,7 +163,8 @@ static int kill_and_resume(unsigned seed, int round, int *interrupted_images)
             ts.tv_sec = (time_t)d;
             ts.tv_nsec = (long)((d - (double)ts.tv_sec) * 1e9);
             nanosleep(&ts, NULL);
-            sig = rand() % 2 ? SIGINT : SIGTERM;
+            static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+            sig = sigs[rand() % 3];
             kill(pid, sig);
         }
         int st = wait_status(pid);
@@ -192,7 +199,7 @@ static int kill_and_resume(unsigned seed, int round, int *interrupted_images)
             assert_non_null(spp);
             assert_non_null(why);
             char expect[96];
-            snprintf(expect, sizeof expect, "%s after %s of " SPP " spp", sig == SIGINT ? "SIGINT" : "SIGTERM", spp);
+            snprintf(expect, sizeof expect, "%s after %s of " SPP " spp", sig_name(sig), spp);
             if (strcmp(spp, SPP) == 0) { /* the signal came after the last pass: the image is whole */
                 assert_string_equal(why, "no");
                 assert_memory_equal(img.rgb, ref.rgb, 3 * sizeof(float) * (size_t)img.w * (size_t)img.h);
@@ -223,32 +230,65 @@ static void test_kill_resume_bitwise(void **state)
     assert_true(kills > 0);
 }
 
-/* A render interrupted mid-way: status 130, the image of the spp reached, metadata saying so. */
+/* A render interrupted mid-way by SIGINT (a terminal's Ctrl-C) or SIGHUP (its terminal closed): status
+ * 128 + the signal, the image of the spp reached, metadata saying so. */
 static void test_interrupted_image(void **state)
 {
     (void)state;
     render_reference();
-    const char *dir = make_dir("interrupt");
+    static const int sigs[] = {SIGINT, SIGHUP};
+    for (int i = 0; i < 2; i++) {
+        const char *dir = make_dir(i ? "interrupt_hup" : "interrupt");
+        const char *extra[] = {"--spp", "100000", "--checkpoint", "ck", "--every", "0", NULL};
+        pid_t pid = start_render(dir, "int.exr", extra);
+        struct timespec ts = {0, 20 * 1000 * 1000};
+        for (int k = 0; k < 3000 && !exists(dir, "ck"); k++) /* the first whole pass is done */
+            nanosleep(&ts, NULL);
+        kill(pid, sigs[i]);
+        int st = wait_status(pid);
+        assert_true(WIFEXITED(st));
+        assert_int_equal(WEXITSTATUS(st), 128 + sigs[i]);
+        no_temporaries(dir);
+        murk_image img = {0};
+        read_exr(dir, "int.exr", &img);
+        int spp = atoi(murk_image_meta(&img, "murk:spp"));
+        assert_true(spp >= 1 && spp < 100000);
+        char expect[96];
+        snprintf(expect, sizeof expect, "%s after %d of 100000 spp", sig_name(sigs[i]), spp);
+        assert_string_equal(murk_image_meta(&img, "murk:interrupted"), expect);
+        assert_string_equal(murk_image_meta(&img, "murk:spp_requested"), "100000");
+        murk_image_free(&img);
+        assert_true(exists(dir, "int.png"));
+    }
+}
+
+/* Started with SIGHUP ignored (`nohup murk render ...`), murk keeps ignoring it: a SIGHUP after the first
+ * pass changes nothing, and the SIGINT that then stops the render is the one the image names. */
+static void test_nohup_keeps_rendering(void **state)
+{
+    (void)state;
+    const char *dir = make_dir("nohup");
     const char *extra[] = {"--spp", "100000", "--checkpoint", "ck", "--every", "0", NULL};
+    ignore_hup = 1;
     pid_t pid = start_render(dir, "int.exr", extra);
+    ignore_hup = 0;
     struct timespec ts = {0, 20 * 1000 * 1000};
-    for (int i = 0; i < 3000 && !exists(dir, "ck"); i++) /* the first whole pass is done */
+    for (int k = 0; k < 3000 && !exists(dir, "ck"); k++)
         nanosleep(&ts, NULL);
+    kill(pid, SIGHUP);
+    nanosleep(&ts, NULL);
+    nanosleep(&ts, NULL);
+    assert_int_equal(waitpid(pid, NULL, WNOHANG), 0); /* still rendering */
     kill(pid, SIGINT);
     int st = wait_status(pid);
     assert_true(WIFEXITED(st));
     assert_int_equal(WEXITSTATUS(st), 130);
-    no_temporaries(dir);
     murk_image img = {0};
     read_exr(dir, "int.exr", &img);
-    int spp = atoi(murk_image_meta(&img, "murk:spp"));
-    assert_true(spp >= 1 && spp < 100000);
-    char expect[96];
-    snprintf(expect, sizeof expect, "SIGINT after %d of 100000 spp", spp);
-    assert_string_equal(murk_image_meta(&img, "murk:interrupted"), expect);
-    assert_string_equal(murk_image_meta(&img, "murk:spp_requested"), "100000");
+    const char *why = murk_image_meta(&img, "murk:interrupted");
+    assert_non_null(why);
+    assert_true(strncmp(why, "SIGINT after ", 13) == 0);
     murk_image_free(&img);
-    assert_true(exists(dir, "int.png"));
 }
 
 /* --resume refuses a checkpoint of another scene, of other overrides, or with more spp than asked. */
@@ -360,6 +400,7 @@ int main(void)
         cmocka_unit_test(test_resume_refuses),
         cmocka_unit_test(test_resume_refuses_changed_inputs),
         cmocka_unit_test(test_interrupted_image),
+        cmocka_unit_test(test_nohup_keeps_rendering),
         cmocka_unit_test(test_kill_resume_bitwise),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);

@@ -134,7 +134,7 @@ typedef struct bench {
     int nbudgets, time_mode, repeat, threads, ref_spp, charts;
     const char *jobs; /* --emit-jobs DIR or --assemble DIR */
     int assemble;
-    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM (murk_cli_catch_stop_signals) */
+    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM/SIGHUP (murk_cli_catch_stop_signals) */
 } bench;
 
 enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
@@ -823,7 +823,7 @@ static int meta_fill(FILE *f, const char *tmp, void *user, char *err, size_t err
 
 /* The chart script (tools/bench_report.py DIR) as a child process, without a shell, once every render is
  * done and bench.csv, bench.json and maps/ are written. It runs in its own process group, so a Ctrl-C
- * reaches murk alone, and murk passes a SIGINT or SIGTERM on to it once: the script then removes the
+ * reaches murk alone, and murk passes a SIGINT, SIGTERM or SIGHUP on to it once: the script then removes the
  * chart it was writing (every chart is a temporary renamed when whole). A signal that came before it
  * started: no charts. 0, or the exit status after a message. */
 static int run_charts(const bench *b)
@@ -1201,7 +1201,7 @@ static const char bench_usage[] =
     "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
     "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
     "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n"
-    "SIGINT/SIGTERM abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
+    "SIGINT/SIGTERM/SIGHUP abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
     "(never bench.csv) and murk exits with 128 + the signal.\n";
 
 int murk_cli_bench(int argc, char **argv)

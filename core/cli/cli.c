@@ -217,10 +217,12 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.0f ", v);
 }
 
-/* SIGINT/SIGTERM during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set and
- * murk goes on. render abandons the running pass, writes the image of the whole passes done
+/* SIGINT/SIGTERM/SIGHUP during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set
+ * and murk goes on. render abandons the running pass, writes the image of the whole passes done
  * (murk:interrupted says so) and exits with 128 + the signal's number; bench (bench.c) stops after the
- * running render, keeps only whole renders' rows and exits the same way. */
+ * running render, keeps only whole renders' rows and exits the same way. A signal that was ignored when
+ * murk started stays ignored: `nohup murk render ...` goes on rendering when its terminal hangs up, as
+ * nohup promises, and a job a non-interactive shell started in the background keeps ignoring SIGINT. */
 static volatile sig_atomic_t render_stop, render_signal;
 
 static void on_stop_signal(int sig)
@@ -231,18 +233,25 @@ static void on_stop_signal(int sig)
 
 volatile sig_atomic_t *murk_cli_catch_stop_signals(void)
 {
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
+        struct sigaction sa, old;
+        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
+            continue;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_stop_signal;
+        sigemptyset(&sa.sa_mask);
+        sigaction(sigs[i], &sa, NULL);
+    }
     return &render_stop;
 }
 
 int murk_cli_stop_status(void) { return 128 + (render_signal ? (int)render_signal : SIGINT); }
 
-const char *murk_cli_stop_name(void) { return render_signal == SIGTERM ? "SIGTERM" : "SIGINT"; }
+const char *murk_cli_stop_name(void)
+{
+    return render_signal == SIGTERM ? "SIGTERM" : render_signal == SIGHUP ? "SIGHUP" : "SIGINT";
+}
 
 /* Under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar. */
 int murk_cli_progress(void)

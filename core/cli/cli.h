@@ -19,8 +19,9 @@ const char *murk_cli_q(const char *s); /* untrusted text made printable (eight r
 void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
 int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
 
-/* SIGINT and SIGTERM set the returned flag (murk_render_opts.stop) instead of ending murk: `render` and
- * `bench` stop cleanly. Then the exit status, 128 + the signal, and its name ("SIGINT", "SIGTERM"). */
+/* SIGINT, SIGTERM and SIGHUP set the returned flag (murk_render_opts.stop) instead of ending murk: `render`
+ * and `bench` stop cleanly (one ignored when murk started stays ignored: nohup). Then the exit status,
+ * 128 + the signal, and its name ("SIGINT", "SIGTERM", "SIGHUP"). */
 volatile sig_atomic_t *murk_cli_catch_stop_signals(void);
 int murk_cli_stop_status(void);
 const char *murk_cli_stop_name(void);
