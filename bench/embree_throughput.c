@@ -4,7 +4,7 @@
  *   build/bench/embree_throughput [scene.yaml] [seconds-per-side-per-round] [rounds] [surfaces]
  *
  * (`surfaces`: leave the media figure out.) Three sides, and on a scene of diffuse triangles (no media,
- * boundaries, spheres or shading normals) the bare tracer's five rungs, each run for the given CPU
+ * boundaries, spheres, shading normals or textures) the bare tracer's five rungs, each run for the given CPU
  * seconds per round:
  *   raw     random incoherent rays — origins uniform in the scene's bounding box, directions uniform on
  *           the sphere — through rtcIntersect1 alone (the yardstick of "murk reaches X % of raw Embree");
@@ -237,7 +237,7 @@ typedef struct bare_pt {
 
 static int bare_supported(const murk_scene *s, murk_rgb **albedo)
 {
-    if (s->nmedia || s->nboundaries || s->camera_medium)
+    if (s->nmedia || s->nboundaries || s->camera_medium || s->ntextures) /* one albedo per shape: no textures */
         return 0;
     for (size_t i = 0; i < s->nmaterials; i++)
         if (strcmp(s->materials[i].plugin->desc->name, "diffuse") != 0)
@@ -641,7 +641,7 @@ int main(int argc, char **argv)
     bare_pt bt = {s, NULL};
     int bare = bare_supported(s, &bt.albedo);
     printf("bare: %s\n", bare ? "`path`'s algorithm written straight against Embree, and the rungs towards murk (bare_li)"
-                              : "left out (the scene has media, boundaries, spheres, shading normals or non-diffuse materials)");
+                              : "left out (the scene has media, boundaries, spheres, shading normals, textures or non-diffuse materials)");
     printf("round  raw Mrays/s  replay Mrays/s  murk Mrays/s  murk/raw  murk/replay");
     for (int j = 0; bare && j < BARE_RUNGS; j++)
         printf("  %s/raw", bare_rung_name[j]);
