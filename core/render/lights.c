@@ -1,6 +1,8 @@
 /* lights.c — emissive shapes as lights: one light per emitting triangle or sphere, chosen in
- * proportion to its power (luminance x area), sampled uniformly by area (triangles) or uniformly in
- * the cone of directions the sphere subtends (spheres). Triangles and quads emit on the side of their
+ * proportion to its power (luminance x area), sampled uniformly by area (triangles; the two triangles
+ * of a rectangular quad or box face as the whole rectangle, p0 + u1 ex + u2 ey, the same density, so
+ * the sampler's 2-D point stays stratified over the lamp) or uniformly in the cone of directions the
+ * sphere subtends (spheres). Triangles and quads emit on the side of their
  * normal only; spheres emit outwards. With MURK_LIGHT_SOLID_ANGLE (murk/plugin.h) the two triangles of
  * a rectangular quad or box face are sampled together, uniformly in the solid angle of the rectangle
  * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
@@ -246,8 +248,14 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
         if (ok >= 0)
             return ok;
     }
-    float su = sqrtf(u[1]);
-    murk_vec3 q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+    murk_vec3 q;
+    if (l->rect) { /* the whole rectangle, uniformly: the same density as its triangle's (both carry
+                    * pmf / area), but the 2-D point keeps the sampler's stratification over the lamp */
+        q = murk_add(l->rp0, murk_add(murk_mul(l->rex, u[1]), murk_mul(l->rey, u[2])));
+    } else {
+        float su = sqrtf(u[1]);
+        q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+    }
     murk_vec3 d = murk_sub(q, p);
     float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
     if (dist <= 0.0f)

@@ -6,9 +6,9 @@
  *              survival probability is min(1, max throughput channel), at least 0.05, and survivors are
  *              divided by it, so roulette adds noise but no bias.
  *   light_sampling  area | solid_angle, default area: how next-event estimation picks a point on a
- *              light: every emitting triangle uniformly by area, or a rectangular quad or box face
- *              uniformly in the solid angle it subtends (Urena et al. 2013; tiny ones and other shapes
- *              by area). solid_angle is far less noisy for points close to a light, but costs more per
+ *              light: every emitting triangle (a rectangular quad or box face: its rectangle) uniformly
+ *              by area, or a rectangular quad or box face uniformly in the solid angle it subtends
+ *              (Urena et al. 2013; tiny ones and other shapes by area). solid_angle is far less noisy for points close to a light, but costs more per
  *              sample: at equal time it is at best even with area (docs/results.md), so area is
  *              the default; both render the same image (tests/test_lights.c).
  *   rr_threshold  float in [0.001, 1], default 1: Russian roulette keeps a path with probability

@@ -6,9 +6,9 @@
  *   max_depth  int in [1, 100000], default 64: most scattering events (surface or medium) per path.
  *   rr_depth   int in [0, 100000], default 3: events before Russian roulette may end a path.
  *   light_sampling  area | solid_angle, default area: how next-event estimation picks a point on a
- *              light: every emitting triangle uniformly by area, or a rectangular quad or box face
- *              uniformly in the solid angle it subtends (Urena et al. 2013; tiny ones and other shapes
- *              by area). solid_angle is far less noisy for points close to a light, but costs more per
+ *              light: every emitting triangle (a rectangular quad or box face: its rectangle) uniformly
+ *              by area, or a rectangular quad or box face uniformly in the solid angle it subtends
+ *              (Urena et al. 2013; tiny ones and other shapes by area). solid_angle is far less noisy for points close to a light, but costs more per
  *              sample: at equal time it is at best even with area (docs/results.md), so area is
  *              the default; both render the same image (tests/test_lights.c).
  *   rr_threshold  float in [0.001, 1], default 1: Russian roulette keeps a path with probability

@@ -192,8 +192,8 @@ typedef struct murk_host {
     size_t (*boundaries)(const murk_scene *scene);
 } murk_host;
 
-/* Light sampling strategies (ABI 1.4). AREA: a triangle (quads and box faces are two) uniformly by
- * area, a sphere uniformly in its cone. SOLID_ANGLE: a rectangular quad or box face uniformly in the
+/* Light sampling strategies (ABI 1.4). AREA: a triangle uniformly by area (a rectangular quad or box
+ * face, two triangles, as the whole rectangle: the same density), a sphere uniformly in its cone. SOLID_ANGLE: a rectangular quad or box face uniformly in the
  * solid angle it subtends (spherical rectangles, Urena et al. 2013) where that solid angle is at least
  * 1e-4 sr (smaller: by area), the rest as AREA. Both choose the light by power. */
 enum { MURK_LIGHT_AREA = 0, MURK_LIGHT_SOLID_ANGLE = 1 };
