@@ -3,9 +3,9 @@
  *
  *   build/bench/embree_throughput [scene.yaml] [seconds-per-side-per-round] [rounds] [surfaces]
  *
- * (`surfaces`: leave the media figure out.) Three sides, and on a scene of diffuse triangles (no media,
- * boundaries, spheres, shading normals or textures) the bare tracer's five rungs, each run for the given CPU
- * seconds per round:
+ * (`surfaces`: leave the media figure out.) Three sides, and on a scene of diffuse triangles (no
+ * media, boundaries, spheres, shading normals or textures) the bare tracer's five rungs, each run for
+ * the given CPU seconds per round:
  *   raw     random incoherent rays — origins uniform in the scene's bounding box, directions uniform on
  *           the sphere — through rtcIntersect1 alone (the yardstick of "murk reaches X % of raw Embree");
  *   replay  the rays murk itself traced in a 4-spp render of the scene (recorded by host.c,
@@ -27,20 +27,21 @@
  *
  * The machine's speed drifts (shared, turbo, neighbours), so the sides are measured in several short
  * interleaved rounds — raw, replay, the rungs, murk, then the same in reverse, ... — each round gives one
- * ratio per pair, and the median ratio is quoted with its spread (min and max over the rounds).
- * Defaults: 1 s, 9 rounds. Every side is timed in CPU seconds, not wall time, which on a shared machine counts the
+ * ratio per pair, and the median ratio is quoted with its spread (min and max over the rounds). Defaults:
+ * 1 s, 9 rounds. Every side is timed in CPU seconds, not wall time, which on a shared machine counts the
  * other processes' time slices too: the Embree sides in the thread's (CLOCK_THREAD_CPUTIME_ID), murk in
  * the process's (CLOCK_PROCESS_CPUTIME_ID: its one render thread works while the main thread waits).
  *
  * Is it fair? Rays are counted the same way on every side: one Embree call, one ray. murk's path tracer
  * makes an occlusion query per shadow ray and, when it reports a hit in a scene with index-matched
  * boundaries, an intersection along the same segment to tell a surface from a boundary; both are rays,
- * counted once each by murk and replayed once each. But murk's rays are cheaper for Embree than the raw side's — its camera rays are
- * coherent and a third of its calls are occlusion queries cut at the light — so the replay runs about
- * 1.4x as many rays per second as the raw side on the Cornell box, and murk / raw flatters murk by that
- * much. murk / replay is the like-for-like ratio (the same Embree work on both sides); it is also the
- * share of murk's time spent inside Embree. Both are printed; the issue's goal (70 %) was stated against
- * raw. bench/throughput.md has the figures and where the rest of murk's time goes.
+ * counted once each by murk and replayed once each. But murk's rays are cheaper for Embree than the raw
+ * side's — its camera rays are coherent and a third of its calls are occlusion queries cut at the light —
+ * so the replay runs about 1.4x as many rays per second as the raw side on the Cornell box, and murk / raw
+ * flatters murk by that much. murk / replay is the like-for-like ratio (the same Embree work on both
+ * sides); it is also the share of murk's time spent inside Embree. Both are printed; the issue's goal
+ * (70 %) was stated against raw. bench/throughput.md has the figures and where the rest of murk's time
+ * goes.
  *
  * Then the media figure, on scenes/cornell_smoke.yaml's cloud with the `delta` tracker (grey extinction):
  * free flights through the medium by the tracker plugin (m->vt->sample, with the core's majorant grid
@@ -313,7 +314,8 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
             rtcInitIntersectContext(&ctx);
             rh.ray.org_x = o.x, rh.ray.org_y = o.y, rh.ray.org_z = o.z;
             rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-            rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f, rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
+            rh.ray.tnear = 0.0f, rh.ray.tfar = INFINITY, rh.ray.time = 0.0f;
+            rh.ray.mask = ~0u, rh.ray.id = 0, rh.ray.flags = 0;
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(s->rtc, &ctx, &rh);
             ++*rays;
@@ -333,7 +335,8 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
                 if (rung >= BARE_HOST_LIGHTS) {
                     lpdf = h->light_pdf_with(s, prev_p, &hit, MURK_LIGHT_AREA);
                 } else {
-                    const murk_light *l = &s->lights[sh->light_base + (int32_t)(rung >= BARE_HOST_RAYS ? hit.prim : rh.hit.primID)];
+                    uint32_t prim = rung >= BARE_HOST_RAYS ? hit.prim : rh.hit.primID;
+                    const murk_light *l = &s->lights[sh->light_base + (int32_t)prim];
                     lpdf = l->pmf * t * t / (cos_o * l->area);
                 }
                 w = bare_power(prev_pdf, lpdf);
@@ -408,7 +411,8 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
                 blocked = sr.tfar < 0.0f;
             }
             if (!blocked)
-                L = murk_rgb_add(L, murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(beta, fl), le), cosi * bare_power(lpdf, bpdf) / lpdf));
+                L = murk_rgb_add(L, murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(beta, fl), le),
+                                                   cosi * bare_power(lpdf, bpdf) / lpdf));
         }
         murk_sample_seek(rng, 2u + (uint32_t)depth * 5u + 2u);
         murk_sample_2d(rng, u);
@@ -640,8 +644,10 @@ int main(int argc, char **argv)
            path, rounds, seconds, rp.n, 100.0 * (double)count_occluded(&rp) / (double)rp.n);
     bare_pt bt = {s, NULL};
     int bare = bare_supported(s, &bt.albedo);
-    printf("bare: %s\n", bare ? "`path`'s algorithm written straight against Embree, and the rungs towards murk (bare_li)"
-                              : "left out (the scene has media, boundaries, spheres, shading normals, textures or non-diffuse materials)");
+    printf("bare: %s\n", bare ? "`path`'s algorithm written straight against Embree, and the rungs towards "
+                                "murk (bare_li)"
+                              : "left out (the scene has media, boundaries, spheres, shading normals, textures or "
+                                "non-diffuse materials)");
     printf("round  raw Mrays/s  replay Mrays/s  murk Mrays/s  murk/raw  murk/replay");
     for (int j = 0; bare && j < BARE_RUNGS; j++)
         printf("  %s/raw", bare_rung_name[j]);
