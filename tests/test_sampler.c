@@ -434,9 +434,9 @@ static void test_rect_light_chi2(void **state)
 
 /* ---- the expected image ------------------------------------------------------------------------ */
 
-/* The sobol sampler with solid-angle light sampling against murk before both (independent, area):
- * two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree, |z| <= 4.5
- * per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
+/* The sobol sampler with solid-angle light sampling against (independent, area), murk's estimators
+ * before both: two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree,
+ * |z| <= 4.5 per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
 static void test_same_image(void **state)
 {
     (void)state;
