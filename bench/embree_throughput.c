@@ -347,11 +347,12 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
             break;
         murk_vec3 n = cos_o >= 0.0f ? ng : murk_neg(ng), tt, bb;
         murk_basis(n, &tt, &bb);
-        murk_hit mh; /* the material's copy (BARE_MATERIALS) */
+        murk_hit mh; /* the material's copy and wo in its frame (BARE_MATERIALS) */
+        murk_vec3 wo_local = murk_v3(0.0f, 0.0f, 1.0f);
         if (rung >= BARE_MATERIALS)
-            mh = hit, mh.n = n;
+            mh = hit, mh.n = n, wo_local = murk_to_local(murk_neg(d), tt, bb, n);
         murk_rgb albedo = bt->albedo[sh - s->shapes], f = murk_rgb_scale(albedo, MURK_INV_PI);
-        murk_vec3 po = bare_offset(p, n), wo_local = murk_to_local(murk_neg(d), tt, bb, n);
+        murk_vec3 po = bare_offset(p, n);
         float u[3];
         murk_sample_seek(rng, 2u + (uint32_t)depth * 5u); /* the slots `path` uses (pathtracer.c) */
         u[0] = murk_sample_1d(rng);
@@ -610,10 +611,7 @@ static int media_figure(double seconds, int rounds)
         ratio[k] = tr / bare;
         printf("%5d  %15.3f  %13.2f  %18.3f  %10.1f %%\n", k + 1, bare / 1e6, steps / 1e6, tr / 1e6, 100.0 * ratio[k]);
     }
-    qsort(ratio, (size_t)rounds, sizeof *ratio, cmp_double);
-    double median = rounds % 2 ? ratio[rounds / 2] : 0.5 * (ratio[rounds / 2 - 1] + ratio[rounds / 2]);
-    printf("tracker / bare loop: median %.1f %%, spread %.1f .. %.1f %% (%d flights ended elsewhere)\n", 100.0 * median,
-           100.0 * ratio[0], 100.0 * ratio[rounds - 1], mismatch);
+    printf("tracker / bare loop: %s (%d flights ended elsewhere)\n", median_spread(ratio, rounds), mismatch);
     free(ratio);
     free(g);
     murk_scene_free(s);
