@@ -246,7 +246,7 @@ static void test_nee(void **state)
         img_stack_render(&b, scene, "bsdf.exr", NEE_SEEDS, 1000, bsdf_only);
         char label[128];
         snprintf(label, sizeof label, "%s (%s)", configs[i].label, configs[i].tracker);
-        nfail += !img_stack_agree(label, &a, &b, NEE_BLOCK, 4.5);
+        nfail += !img_stack_agree(label, &a, &b, NEE_BLOCK);
         img_stack_free(&a);
         img_stack_free(&b);
     }
@@ -286,7 +286,7 @@ static void test_path(void **state)
     }
     img_stack_render(&b, write_tmp("path_nobox.yaml", text), "path_nobox.exr", 4, 10, surf);
     free(text);
-    int ok = img_stack_agree("path with and without a boundary box", &a, &b, NEE_BLOCK, 4.5);
+    int ok = img_stack_agree("path with and without a boundary box", &a, &b, NEE_BLOCK);
     img_stack_free(&a);
     img_stack_free(&b);
     assert_true(ok);
