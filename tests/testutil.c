@@ -286,6 +286,25 @@ int img_stack_must_differ(const char *label, const img_stack *a, const img_stack
     return stat_must_fail(label, !agree, z);
 }
 
+int img_stack_must_differ_block(const char *label, const img_stack *a, const img_stack *r, int block, double bias)
+{
+    size_t np = (size_t)a->w * (size_t)a->h;
+    img_stack b = *a;
+    b.mean = malloc(np * sizeof *b.mean);
+    assert_non_null(b.mean);
+    memcpy(b.mean, a->mean, np * sizeof *b.mean);
+    int bx = a->w / block / 2, by = a->h / block / 2; /* the block at the centre */
+    for (int y = by * block; y < (by + 1) * block; y++)
+        for (int x = bx * block; x < (bx + 1) * block; x++)
+            for (int c = 0; c < 4; c++)
+                b.mean[(size_t)y * (size_t)a->w + (size_t)x][c] *= 1.0 + bias;
+    char l[256];
+    snprintf(l, sizeof l, "%s, block (%d,%d) %+g%%", label, bx, by, 100.0 * bias);
+    int ok = img_stack_must_differ(l, &b, r, block);
+    free(b.mean);
+    return ok;
+}
+
 void run_murk_ok(const char *const *args, const char *const *extra)
 {
     const char *all[65];
