@@ -11,6 +11,27 @@ static double alpha_sum, beta_sum;
 
 double stat_tail2(double z) { return erfc(fabs(z) / sqrt(2.0)); }
 
+double stat_tail2_t(double t, double nu)
+{
+    /* 2 x the integral of the density from |t| on (Simpson in u = 1 / x over (0, 1 / |t|]: no infinite
+     * range), the density c (1 + x^2 / nu)^(-(nu + 1) / 2) */
+    double a = fabs(t);
+    if (!(a > 0.0))
+        return 1.0;
+    double lc = lgamma((nu + 1.0) / 2.0) - lgamma(nu / 2.0) - 0.5 * log(nu * 3.14159265358979323846);
+    const int n = 2000;
+    double h = (1.0 / a) / n, sum = 0.0;
+    for (int i = 0; i <= n; i++) {
+        double u = i * h, f = 0.0;
+        if (u > 0.0) { /* x = 1 / u, dx = du / u^2 */
+            double x = 1.0 / u;
+            f = exp(lc - 0.5 * (nu + 1.0) * log1p(x * x / nu)) / (u * u);
+        }
+        sum += f * (i == 0 || i == n ? 1.0 : (i % 2 ? 4.0 : 2.0));
+    }
+    return 2.0 * sum * h / 3.0;
+}
+
 double stat_probit_upper(double p)
 {
     if (!(p > 1e-300))

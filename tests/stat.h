@@ -31,6 +31,8 @@
 
 /* Two-sided normal tail 2 (1 - Phi(z)). */
 double stat_tail2(double z);
+/* Two-sided tail of Student's t with nu degrees of freedom (a mean whose se comes from nu + 1 values). */
+double stat_tail2_t(double t, double nu);
 /* The z with one-sided tail 1 - Phi(z) = p (p in (0, 0.5]; p below 1e-300 gives 37). */
 double stat_probit_upper(double p);
 
