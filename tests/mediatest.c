@@ -207,8 +207,7 @@ int mt_check(const char *head, const mt_acc *a, const double expect[3], double r
 /* The empirical Bernstein bound of mt_check_bounded for channel c. */
 static double eb_bound(const mt_acc *a, int c, double wmax)
 {
-    double L = log(4.0 / stat_tail2(STAT_Z)), n = (double)a->n, w = fmax(wmax, a->amax[c]);
-    return sqrt(2.0 * mt_var(a, c) * L / n) + 7.0 * (2.0 * w) * L / (3.0 * (n - 1.0));
+    return stat_eb_bound(mt_var(a, c), a->n, 2.0 * fmax(wmax, a->amax[c]));
 }
 
 double mt_zmax_bounded(const mt_acc *a, const double expect[3], double wmax)

@@ -61,6 +61,18 @@ int stat_z_ok(double est, double se, double expect, double slack)
     return fabs(est - expect) <= STAT_Z * se + slack; /* NaN fails */
 }
 
+double stat_eb_bound(double var, long n, double range)
+{
+    double L = log(4.0 / stat_tail2(STAT_Z)), dn = (double)n;
+    return sqrt(2.0 * fmax(var, 0.0) * L / dn) + 7.0 * range * L / (3.0 * (dn - 1.0));
+}
+
+int stat_bounded_ok(double est, double var, long n, double expect, double range, double slack)
+{
+    stat_count(1, stat_tail2(STAT_Z));
+    return fabs(est - expect) <= stat_eb_bound(var, n, range) + slack;
+}
+
 double stat_z2(double a, double se_a, double b, double se_b)
 {
     double se = hypot(se_a, se_b);
@@ -106,12 +118,13 @@ double stat_scale(void)
     return scale;
 }
 
-long stat_n(long n)
+long stat_n_min(long n, long lo)
 {
     long m = (long)((double)n * stat_scale());
-    long floor_n = n < 2000 ? n : 2000;
-    return m > floor_n ? m : floor_n;
+    return m > lo ? m : (lo < n ? lo : n);
 }
+
+long stat_n(long n) { return stat_n_min(n, 2000); }
 
 int stat_power(void) { return stat_scale() >= 1.0; }
 

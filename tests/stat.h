@@ -44,6 +44,14 @@ void stat_count(long n, double alpha);
 int stat_z_ok(double est, double se, double expect, double slack);
 /* z of a difference of two independent estimates (their standard errors combined). */
 double stat_z2(double a, double se_a, double b, double se_b);
+/* The empirical Bernstein bound (Maurer and Pontil 2009, theorem 4, both sides) on |mean - expectation|
+ * of n independent samples with sample variance var that lie in an interval of length range, at the
+ * false-alarm probability of a STAT_Z z-test: sqrt(2 var L / n) + 7 range L / (3 (n - 1)), L =
+ * ln(4 / stat_tail2(STAT_Z)). It holds for any such distribution, also where the sample variance misses
+ * rare values (heavy tails, or nearly constant samples with rare exceptions); the price is the second
+ * term. stat_bounded_ok: |est - expect| within it plus slack, counted as one decision. */
+double stat_eb_bound(double var, long n, double range);
+int stat_bounded_ok(double est, double var, long n, double expect, double range, double slack);
 /* The chi-square decision: 1 if p >= STAT_P. Counts one decision. */
 int stat_chi2_ok(double p);
 
@@ -55,9 +63,11 @@ int stat_must_fail(const char *label, int failed, double z);
 /* The same for a chi-square: p of the mutant. */
 int stat_must_fail_chi2(const char *label, double p);
 
-/* MURK_TEST_SCALE (1 if unset); stat_n(n): n x the scale, at least min(n, 2000). */
+/* MURK_TEST_SCALE (1 if unset); stat_n(n): n x the scale, at least min(n, 2000); stat_n_min: at least
+ * lo (sample counts of renders: spp). */
 double stat_scale(void);
 long stat_n(long n);
+long stat_n_min(long n, long lo);
 /* 1 when power is judged (the scale is 1). */
 int stat_power(void);
 

@@ -283,7 +283,7 @@ static void test_energy(void **state)
                         murk_vec3 wo = wo_at(angles[a], inside);
                         murk_rng rng;
                         murk_rng_seed(&rng, 41, (uint64_t)(i * 3 + r), (uint64_t)(a * 2 + inside));
-                        long n = 40000;
+                        long n = stat_n(40000);
                         double s1 = 0.0, s2 = 0.0;
                         for (long k = 0; k < n; k++) {
                             float u[3] = {murk_rng_float(&rng), murk_rng_float(&rng), murk_rng_float(&rng)};

@@ -250,7 +250,7 @@ static float plateau_f(int x, int y, int z, float cx, float cy, float cz)
 }
 
 #define NCONFIGS (NTRACKERS + 1)
-#define NPIX 128
+#define NPIX (int)stat_n_min(128, 16)
 
 static void test_first_distance(void **state)
 {

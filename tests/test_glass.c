@@ -107,7 +107,7 @@ static void test_furnace(void **state)
             for (int integ = 0; integ < 3; integ++) {
                 if (med && integ == 0)
                     continue;
-                stats st = furnace(s, integ == 2, integ > 0, rough ? 40000 : 20000, 100u + (uint64_t)integ);
+                stats st = furnace(s, integ == 2, integ > 0, stat_n(rough ? 40000 : 20000), 100u + (uint64_t)integ);
                 double m = mean(&st, 1), e = se(&st, 1);
                 /* smooth: 1; rough (compensated): 1 within noise and the tables' error, and the three
                  * integrators agree */
@@ -281,7 +281,7 @@ static void test_slab(void **state)
                     murk_ray ray = {murk_v3((float)sin(th), 0, 0), murk_v3((float)sin(th), (float)cos(th), 0), 0.0f, INFINITY};
                     ray.o = inside ? murk_v3(0, 0.25f, 0) : murk_v3(0, -1, 0);
                     stats st = {{0}, {0}, 0};
-                    for (long i = 0; i < 50000; i++) {
+                    for (long i = 0, n = stat_n(50000); i < n; i++) {
                         murk_rng rng;
                         murk_rng_seed(&rng, 900u + t, (uint64_t)(a * 8 + integ * 2 + inside), (uint64_t)i);
                         add(&st, murk_pt_li(&pt, s, &ray, &rng));

@@ -151,7 +151,7 @@ static double now(void)
 
 /* 1 in the suite 'long' (the long_* tests). */
 static int longrun;
-#define FURNACE_SPP (longrun ? 8192 : 512) /* 16x16 pixels: se <= 0.0035 per channel even for naive_spectral's 3x hero */
+#define FURNACE_SPP (int)stat_n_min(longrun ? 8192 : 512, 16) /* 16x16 pixels: se <= 0.0035 per channel even for naive_spectral's 3x hero */
 #define INV_SEEDS 8                          /* renders per config (different seeds), for per-pixel variances */
 #define INV_SPP 4096                         /* spp per render */
 #define INV_DENSER "1.01"                    /* the density change the comparison must detect */
@@ -277,7 +277,7 @@ static void test_slab(void **state)
                 const char *scene = scene_file(
                     "slab.yaml",
                     "murk: 1\n"
-                    "render: { resolution: [32, 32], spp: 256, seed: 13 }\n"
+                    "render: { resolution: [32, 32], spp: %d, seed: 13 }\n"
                     "camera: { from: [0.1, 0.2, 5], at: [0.1, 0.2, 0], up: [0, 1, 0], fov: 1 }\n"
                     "integrator: { type: %s, max_depth: 8 }\n"
                     "materials: { black: { type: diffuse, albedo: 0 } }\n"
@@ -286,7 +286,7 @@ static void test_slab(void **state)
                     "shapes:\n"
                     "  - { type: box, min: [-10, -10, -0.5], max: [10, 10, 0.5], interior: slab }\n"
                     "  - { type: quad, center: [0, 0, -3], u: [20, 0, 0], v: [0, 20, 0], material: black, emission: 1 }\n",
-                    INTEGRATORS[i], TRACKERS[t], d ? ", majorant_factor: 3" : "");
+                    (int)stat_n_min(256, 16), INTEGRATORS[i], TRACKERS[t], d ? ", majorant_factor: 3" : "");
                 murk_image img;
                 render_img(scene, out_path("slab.exr"), &img, NULL, NULL, NULL, NULL);
                 chstats st;
@@ -481,13 +481,13 @@ static void test_camera_inside(void **state)
         for (size_t k = 0; k < 2; k++) {
             const char *scene = scene_file("camera_inside.yaml",
                 "murk: 1\n"
-                "render: { resolution: [16, 16], spp: 1024, seed: 4 }\n"
+                "render: { resolution: [16, 16], spp: %d, seed: 4 }\n"
                 "camera: { from: [0, 0, 0], at: [0, 0, -1], up: [0, 1, 0], fov: 60, medium: fog }\n"
                 "integrator: { type: %s, max_depth: 100000 }\n"
                 "background: 1\n"
                 "media: { fog: { type: %s, density: { constant: 1 }, sigma_a: 0, sigma_s: [0.5, 1, 2] } }\n"
                 "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, interior: fog } ]\n",
-                INTEGRATORS[k], TRACKERS[t]);
+                (int)stat_n_min(512, 16), INTEGRATORS[k], TRACKERS[t]);
             murk_image img;
             render_img(scene, out_path("camera_inside.exr"), &img, NULL, NULL, NULL, NULL);
             const double one[3] = {1, 1, 1};
@@ -501,12 +501,12 @@ static void test_camera_inside(void **state)
     /* absorbing fog, sigma_a = [0.5, 1, 2], radius 1: every camera ray sees exp(-sigma_a) */
     const char *scene = scene_file("camera_inside_abs.yaml",
         "murk: 1\n"
-        "render: { resolution: [16, 16], spp: 1024, seed: 4 }\n"
+        "render: { resolution: [16, 16], spp: %d, seed: 4 }\n"
         "camera: { from: [0, 0, 0], at: [0, 0, -1], up: [0, 1, 0], fov: 60, medium: fog }\n"
         "integrator: { type: volpath_nee }\n"
         "background: 1\n"
         "media: { fog: { type: spectral_mis, density: { constant: 1 }, sigma_a: [0.5, 1, 2], sigma_s: 0 } }\n"
-        "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, interior: fog } ]\n");
+        "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, interior: fog } ]\n", (int)stat_n_min(512, 16));
     murk_image img;
     render_img(scene, out_path("camera_inside_abs.exr"), &img, NULL, NULL, NULL, NULL);
     const double ex[3] = {exp(-0.5), exp(-1.0), exp(-2.0)};
