@@ -133,7 +133,7 @@ int stat_run_tests(const char *name, const struct CMUnitTest *tests, size_t n, i
     setvbuf(stdout, NULL, _IOLBF, 0); /* keep the figures in order with murk's messages on stderr */
     int want_long = argc > 1 && !strcmp(argv[1], "--long");
     if (want_long)
-        cmocka_set_test_filter("long_*");
+        cmocka_set_test_filter(argc > 2 ? argv[2] : "long_*");
     else {
         cmocka_set_skip_filter("long_*");
         if (argc > 1)

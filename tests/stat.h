@@ -72,8 +72,9 @@ long stat_n_min(long n, long lo);
 int stat_power(void);
 
 /* Runs the program's cmocka tests and prints the sums. With the argument "--long" only the tests
- * whose names start with "long_" run (they are the program's part in the suite 'long'), otherwise
- * those are skipped; any other argument is a cmocka test filter. */
+ * whose names start with "long_" run (they are the program's part in the suite 'long'; a second
+ * argument narrows them: --long long_image), otherwise those are skipped; any other argument is a
+ * cmocka test filter. */
 int stat_run_tests(const char *name, const struct CMUnitTest *tests, size_t n, int argc, char **argv);
 /* long_NAME: test_NAME again with `flag` set to 1 (the program's switch to more samples), as a test of the
  * suite 'long'. */

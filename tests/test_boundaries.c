@@ -12,7 +12,8 @@
  *   shadow_once a scene without boundaries (host->boundaries() 0) ends a shadow ray that occluded()
  *               reports blocked without tracing it again: the Cornell box renders bitwise what it
  *               renders with an index-matched box out of every ray's reach added, with fewer rays.
- * In the suite 'long' (long_* tests, 64x64, 8 seeds, 8x8-pixel blocks: a block's standard error is
+ * In the suite 'long' (long_* tests, 32x32, 8 seeds, 8x8-pixel blocks: 16 blocks, each with the
+ * samples of test_boundaries_long's 64x64 blocks, at a quarter of its cost: a block's standard error is
  * about 0.1 % of its value):
  *   nee         volpath_nee (light sampling + MIS) against volpath (BSDF / phase sampling only) on a
  *               Cornell box holding a medium behind an index-matched boundary, the light outside it:
@@ -38,7 +39,7 @@
 #include "pathtracer.h"
 #include "scene.h"
 
-#define NEE_RES 64
+#define NEE_RES 32
 #define NEE_BLOCK 8
 #define NEE_SEEDS 8
 #define NEE_SPP "2048"

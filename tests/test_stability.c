@@ -24,9 +24,10 @@
  *                      largest weights were 240 to 37700: the WMAX assertion sees that.
  * Checked by hand that it fails when wrong: dropping the weight of the violating collision in delta.c (the
  * raise alone) fails delta's pass-through and scatter by > 30 se; raising the majorant before the
- * collision's choice instead of after it fails them as well. The render-level checks (every sweep's
- * extreme points of the atlas, finite and |z| <= 5 against the bounding case or the closed form) are the
- * `stability_quick` test (bench/stability/atlas.py --quick --check). */
+ * collision's choice instead of after it fails them as well. The render-level checks are the
+ * `stability_quick` test (every sweep's extreme points of the atlas finite: bench/stability/atlas.py
+ * --quick --check --finite-only) and the suite 'stability' (the whole atlas, |z| <= 5 against the
+ * bounding case or the closed form). */
 #include "mediatest.h"
 
 #include <math.h>
