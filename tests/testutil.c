@@ -294,12 +294,24 @@ int img_stack_must_differ_block(const char *label, const img_stack *a, const img
     assert_non_null(b.mean);
     memcpy(b.mean, a->mean, np * sizeof *b.mean);
     int bx = a->w / block / 2, by = a->h / block / 2; /* the block at the centre */
+    if (!(bias > 0.0)) { /* 10 standard errors of the block's difference in its noisiest channel */
+        for (int c = 0; c < 3; c++) {
+            double m = 0.0, v = 0.0;
+            for (int y = by * block; y < (by + 1) * block; y++)
+                for (int x = bx * block; x < (bx + 1) * block; x++) {
+                    size_t p = (size_t)y * (size_t)a->w + (size_t)x;
+                    m += a->mean[p][c];
+                    v += a->var[p][c] + r->var[p][c];
+                }
+            bias = fmax(bias, m > 0.0 ? 10.0 * sqrt(v) / m : 0.0);
+        }
+    }
     for (int y = by * block; y < (by + 1) * block; y++)
         for (int x = bx * block; x < (bx + 1) * block; x++)
             for (int c = 0; c < 4; c++)
                 b.mean[(size_t)y * (size_t)a->w + (size_t)x][c] *= 1.0 + bias;
     char l[256];
-    snprintf(l, sizeof l, "%s, block (%d,%d) %+g%%", label, bx, by, 100.0 * bias);
+    snprintf(l, sizeof l, "%s, block (%d,%d) %+.2g%%", label, bx, by, 100.0 * bias);
     int ok = img_stack_must_differ(l, &b, r, block);
     free(b.mean);
     return ok;

@@ -78,7 +78,9 @@ int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, i
 /* The same comparison as a must-fail case (stat_must_fail, not counted as decisions): a has a known bias
  * and must differ. Returns 1 if it does. */
 int img_stack_must_differ(const char *label, const img_stack *a, const img_stack *r, int block);
-/* The must-fail case "a bias in one block": a with its centre block's means times 1 + bias against r. */
+/* The must-fail case "a bias in one block": a with its centre block's means times 1 + bias against r.
+ * bias <= 0: 10 standard errors of that block's difference in its noisiest channel (printed in percent:
+ * the comparison's resolution where no mutant of the renderer is at hand). */
 int img_stack_must_differ_block(const char *label, const img_stack *a, const img_stack *r, int block, double bias);
 
 /* Pearson chi-square test of observed counts against expected counts, merging bins (in order of
