@@ -4,6 +4,7 @@
  * is one line naming the file and the cause. */
 #define _GNU_SOURCE /* dladdr() */
 #include "plugin_loader.h"
+#include "runtime.h"
 #include "util.h"
 
 #include "murk/integrator.h"

@@ -10,6 +10,7 @@
 #include "density.h"
 #include "host.h"
 #include "media.h"
+#include "runtime.h"
 #include "scene.h"
 
 /* ---- scenes ----------------------------------------------------------------------------------- */

@@ -49,6 +49,7 @@
 #include "density.h"
 #include "host.h"
 #include "plugin_loader.h"
+#include "runtime.h"
 #include "scene.h"
 #include "sphere.h"
 #include "murk/murk.h"

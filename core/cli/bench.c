@@ -10,6 +10,7 @@
 #include "media.h"
 #include "metrics.h"
 #include "scene.h"
+#include "runtime.h"
 #include "util.h"
 
 #include <errno.h>

@@ -17,6 +17,7 @@
 #include "mpi_job.h"
 #include "plugin_loader.h"
 #include "scene.h"
+#include "runtime.h"
 #include "util.h"
 
 #include <dirent.h>

@@ -20,16 +20,14 @@
  *       ...                         # the tracker's own parameters */
 #include "media.h"
 #include "density.h"
-#include "host.h"
 #include "limit.h"
 #include "params.h"
+#include "runtime.h"
 #include "scene.h"
 #include "util.h"
 #include "yread.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,7 +36,7 @@ struct murk_density {
     murk_field *field;
     murk_bound_grid grid;
     float factor;
-    unsigned slot; /* its medium's cost counters (host.h) */
+    unsigned slot; /* its medium's cost counters (runtime.h) */
 };
 
 MURK_API void murk_density_parts(const murk_density *d, const murk_field **field, const murk_bound_grid **grid,
@@ -52,7 +50,7 @@ MURK_API void murk_density_parts(const murk_density *d, const murk_field **field
 typedef struct walk {
     murk_dda dda;
     float factor;
-    murk_counters *count; /* this thread's block for the medium (host.h), taken once per walk */
+    murk_counters *count; /* this thread's block for the medium (runtime.h), taken once per walk */
 } walk;
 
 _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
@@ -86,44 +84,6 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     if (dmin)
         *dmin = mn;
     return r;
-}
-
-static pthread_mutex_t warn_lock = PTHREAD_MUTEX_INITIALIZER;
-static struct { char *msg; unsigned long count; } warned[128];
-static int nwarned;
-
-void murk_warn_once(const char *fmt, ...)
-{
-    char buf[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    pthread_mutex_lock(&warn_lock);
-    int i = 0;
-    while (i < nwarned && strcmp(warned[i].msg, buf) != 0)
-        i++;
-    if (i < nwarned) {
-        warned[i].count++;
-    } else if (nwarned < (int)(sizeof warned / sizeof warned[0])) {
-        warned[nwarned].msg = murk_strdup(buf);
-        warned[nwarned].count = 1;
-        nwarned++;
-        murk_log(MURK_LOG_WARN, "%s", buf);
-    }
-    pthread_mutex_unlock(&warn_lock);
-}
-
-MURK_API void murk_warn_summary(void)
-{
-    pthread_mutex_lock(&warn_lock);
-    for (int i = 0; i < nwarned; i++) {
-        if (warned[i].count > 1)
-            murk_log(MURK_LOG_WARN, "(%lu times in all) %s", warned[i].count, warned[i].msg);
-        free(warned[i].msg);
-    }
-    nwarned = 0;
-    pthread_mutex_unlock(&warn_lock);
 }
 
 float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi)
@@ -403,7 +363,7 @@ int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen
             memset(nm, 0, sizeof *nm);
             return -1;
         }
-        murk_host_count_medium(&nm->m, nm->density->slot);
+        murk_media_count_medium(&nm->m, nm->density->slot);
         s->nmedia++;
     }
     return 0;

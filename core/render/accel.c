@@ -2,6 +2,7 @@
  * point-spheres for spheres. Geometry ids equal shape indices. */
 #include "accel.h"
 #include "error.h"
+#include "runtime.h"
 #include "util.h"
 
 #include <stdio.h>

@@ -18,6 +18,7 @@
 #include "checkpoint.h"
 #include "error.h"
 #include "host.h"
+#include "runtime.h"
 #include "mpi_job.h"
 #include "scene.h"
 #include "util.h"
@@ -211,7 +212,7 @@ static void *worker(void *arg)
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
     pthread_mutex_lock(&j->lock);
-    murk_host_thread_counters_add(j->media, j->nslots);
+    murk_thread_counters_add(j->media, j->nslots);
     if (peak > j->max_sample)
         j->max_sample = peak;
     pthread_mutex_unlock(&j->lock);

@@ -6,6 +6,7 @@
 #include "media.h"
 #include "scene.h"
 #include "texture.h"
+#include "runtime.h"
 #include "util.h"
 #include "yread.h"
 

@@ -1,5 +1,6 @@
 /* limit.c — the limits murk enforces on input sizes, with their environment overrides (limit.h). */
 #include "limit.h"
+#include "runtime.h"
 #include "util.h"
 
 #include <errno.h>

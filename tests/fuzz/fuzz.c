@@ -11,6 +11,7 @@
 #include "image.h"
 #include "murk/murk.h"
 #include "obj.h"
+#include "runtime.h"
 #include "util.h"
 
 #include <stdint.h>
