@@ -222,7 +222,7 @@ static size_t skip_keys(const murk_plugin_desc *d, const char **out, size_t cap)
 
 /* `transmittance: NAME` or `transmittance: { type: NAME, key: value, ... }`: the medium's estimator plugin,
  * its parameters checked against its schema like a tracker's, created on the medium's data. */
-static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, murk_named_medium *nm, char *err,
+static int load_estimator(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *n, murk_named_medium *nm, char *err,
                           size_t errlen)
 {
     static const char *const skip[] = {"type"};
@@ -234,7 +234,7 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
     snprintf(block, sizeof block, "medium '%s': transmittance", name);
     snprintf(who, sizeof who, "medium '%s' transmittance (%s)", name, t->str);
     const murk_plugin *p;
-    if (murk_scene_instantiate(s, MURK_KIND_TRANSMITTANCE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP,
+    if (murk_scene_instantiate(s, host, MURK_KIND_TRANSMITTANCE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP,
                                &nm->data, &p, &nm->m.tr_self, err, errlen))
         return -1;
     nm->m.tr_vt = p->desc->vtable;
@@ -242,7 +242,7 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
     return 0;
 }
 
-static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
+static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
                        size_t errlen)
 {
     char block[256], who[256];
@@ -267,7 +267,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     const murk_plugin_desc core_desc = {sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, tp->desc->name, "the core's keys",
                                         murk_medium_core_params, MURK_MEDIUM_NCORE, NULL, NULL};
     murk_value core[MURK_MEDIUM_NCORE];
-    if (murk_scene_read_plugin_params(s, &core_desc, m, who, skip, nskip, core, err, errlen))
+    if (murk_scene_read_plugin_params(s, &core_desc, m, who, skip, nskip, 0, core, err, errlen))
         return -1;
     murk_medium_data *md = &nm->data;
     md->size = sizeof *md;
@@ -326,7 +326,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     for (size_t i = 0; i < MURK_MEDIUM_NCORE; i++)
         skip[nskip++] = murk_medium_core_params[i].name;
     const murk_plugin *p;
-    if (murk_scene_instantiate(s, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self, err,
+    if (murk_scene_instantiate(s, host, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self, err,
                                errlen))
         return -1;
     nm->m.vt = p->desc->vtable;
@@ -334,7 +334,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     nm->m.data = md;
     nm->plugin = p;
     const murk_ynode *tn = murk_ymap_get(m, "transmittance");
-    return tn ? load_estimator(s, name, tn, nm, err, errlen) : 0;
+    return tn ? load_estimator(s, host, name, tn, nm, err, errlen) : 0;
 }
 
 static void medium_free(murk_named_medium *nm)
@@ -351,14 +351,14 @@ static void medium_free(murk_named_medium *nm)
     free(nm->name);
 }
 
-int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+int murk_media_load(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     if (n->kind != MURK_Y_MAP)
         return murk_yerr(err, errlen, n, "media must be a map of NAME: { type: TRACKER, ... }");
     s->media = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->media);
     for (size_t i = 0; i < n->n; i++) {
         murk_named_medium *nm = &s->media[i];
-        if (load_medium(s, n->keys[i], n->items[i], nm, err, errlen) != 0) {
+        if (load_medium(s, host, n->keys[i], n->items[i], nm, err, errlen) != 0) {
             medium_free(nm);
             memset(nm, 0, sizeof *nm);
             return -1;

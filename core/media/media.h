@@ -7,7 +7,9 @@
 #include "murk/murk.h"
 #include "yamldoc.h"
 
-int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+/* The `media:` block n: each medium's data, density and tracker (and estimator) plugins, created with the
+ * services table host. */
+int murk_media_load(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen);
 /* Refuses a medium whose optical depth (largest extinction x max density x majorant_factor x extent:
  * its density box, or the scene's box [scene_lo, scene_hi] for a constant density) exceeds
  * MURK_MAX_OPTICAL_DEPTH (limit.h): a located error at the medium's scale/sigma key. */
