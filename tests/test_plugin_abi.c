@@ -1,4 +1,4 @@
-/* test_plugin_abi.c — the plugin loader (core/plugin.c) against the fixture plugins in
+/* test_plugin_abi.c — the plugin loader (core/plugin/plugin.c) against the fixture plugins in
  * tests/fixtures (built into the build's tests/fixtures folder, reached only through MURK_PLUGIN_PATH):
  * every refusal is rc -1 with one precise line naming the file; plugin code is never run before the
  * ABI check (abi_major/abi_minor/no_abi abort() if their entry is called); only the plugins a scene

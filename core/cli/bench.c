@@ -9,6 +9,7 @@
 #include "image.h"
 #include "media.h"
 #include "metrics.h"
+#include "load.h"
 #include "scene.h"
 #include "runtime.h"
 #include "util.h"

@@ -16,6 +16,7 @@
 #include "media.h"
 #include "mpi_job.h"
 #include "plugin_loader.h"
+#include "load.h"
 #include "scene.h"
 #include "runtime.h"
 #include "util.h"

@@ -5,6 +5,7 @@
 #include "cli.h"
 #include "density.h"
 #include "media.h"
+#include "load.h"
 #include "scene.h"
 #include "util.h"
 

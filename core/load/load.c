@@ -4,7 +4,7 @@
  * Every key is checked: the core's own blocks against the tables below, plugin blocks against the
  * plugin's parameter schema (params.c); the `media:` block is media.c's. Every error is one line
  * "file:line:col: what is wrong". */
-#include "scene.h"
+#include "load.h"
 #include "accel.h"
 #include "checkpoint.h"
 #include "host.h"
