@@ -5,7 +5,7 @@
  * names are loaded; `murk render` / `murk plugins` report the same; an empty MURK_PLUGIN_PATH entry
  * never means the current folder. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <dlfcn.h>
 #include <stdio.h>
@@ -14,8 +14,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "plugin_loader.h"
-#include "scene.h"
+#include "plugin/plugin_loader.h"
+#include "scene/scene.h"
 
 static char err[2048];
 

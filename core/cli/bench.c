@@ -4,15 +4,15 @@
  * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
  * the charts and report.md. Also the counters' text forms (the end-of-render summary, murk:counters).
  * Part of the murk executable. */
-#include "atomic.h"
-#include "cli.h"
-#include "image.h"
-#include "media.h"
-#include "metrics.h"
-#include "load.h"
-#include "scene.h"
-#include "runtime.h"
-#include "util.h"
+#include "cli/cli.h"
+#include "cli/metrics.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>

@@ -7,19 +7,19 @@
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "check.h"
-#include "cli.h"
-#include "density.h"
-#include "atomic.h"
-#include "image.h"
-#include "limit.h"
-#include "media.h"
-#include "mpi_job.h"
-#include "plugin_loader.h"
-#include "load.h"
-#include "scene.h"
-#include "runtime.h"
-#include "util.h"
+#include "check/check.h"
+#include "cli/cli.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/density.h"
+#include "media/media.h"
+#include "plugin/plugin_loader.h"
+#include "render/mpi_job.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <dirent.h>
 #include <errno.h>

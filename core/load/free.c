@@ -1,9 +1,9 @@
 /* free.c — what a loaded scene owns and how it is released: murk_scene_free, the inverse of load.c's
  * murk_scene_load (the scene's data, scene.h, sits below the media and render parts it frees). */
-#include "load.h"
-#include "media.h"
-#include "texture.h"
-#include "util.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "scene/texture.h"
+#include "util/util.h"
 
 #include <stdlib.h>
 

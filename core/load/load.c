@@ -4,16 +4,16 @@
  * Every key is checked: the core's own blocks against the tables below, plugin blocks against the
  * plugin's parameter schema (params.c); the `media:` block is media.c's. Every error is one line
  * "file:line:col: what is wrong". */
-#include "load.h"
-#include "accel.h"
-#include "checkpoint.h"
-#include "host.h"
-#include "limit.h"
-#include "media.h"
-#include "obj.h"
-#include "params.h"
-#include "util.h"
-#include "yread.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "render/accel.h"
+#include "render/checkpoint.h"
+#include "render/host.h"
+#include "scene/obj.h"
+#include "scene/params.h"
+#include "util/limit.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "scene.h"
+#include "scene/scene.h"
 
 /* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
  * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the

@@ -1,9 +1,9 @@
 /* counted.c — the core's counting wrappers around a scene's medium: every free flight that scatters
  * and every transmittance estimate is added to the medium's cost counters (murk/counters.h), whatever
  * the tracker's or estimator's code. */
-#include "media.h"
-#include "runtime.h"
-#include "util.h"
+#include "media/media.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <stdlib.h>
 

@@ -18,14 +18,14 @@
  *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
  *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
-#include "media.h"
-#include "density.h"
-#include "limit.h"
-#include "params.h"
-#include "runtime.h"
-#include "scene.h"
-#include "util.h"
-#include "yread.h"
+#include "media/media.h"
+#include "media/density.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
 #include <stdio.h>

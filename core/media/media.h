@@ -5,7 +5,7 @@
 
 #include "murk/medium.h"
 #include "murk/murk.h"
-#include "yamldoc.h"
+#include "yaml/yamldoc.h"
 
 /* The `media:` block n: each medium's data, density and tracker (and estimator) plugins, created with the
  * services table host. */

@@ -1,13 +1,13 @@
 /* host.c — the services table plugins receive: memory, logging, textures, and the scene queries
  * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays and the cost
  * counters (murk/counters.h) are counted per thread and summed by render.c when a thread's work ends. */
-#include "host.h"
-#include "accel.h"
-#include "media.h"
-#include "runtime.h"
-#include "scene.h"
-#include "texture.h"
-#include "util.h"
+#include "render/host.h"
+#include "media/media.h"
+#include "render/accel.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <stdarg.h>
 #include <stdatomic.h>

@@ -14,14 +14,14 @@
  * per pixel). The other ranks never hold the image: their render threads advance a tile's state in the
  * TILE message it came in (a held tile), so a rank's memory is its threads + 1 tiles of 7 KB whatever
  * the image's size. After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
-#include "camera.h"
-#include "checkpoint.h"
-#include "error.h"
-#include "host.h"
-#include "runtime.h"
-#include "mpi_job.h"
-#include "scene.h"
-#include "util.h"
+#include "render/camera.h"
+#include "render/checkpoint.h"
+#include "render/host.h"
+#include "render/mpi_job.h"
+#include "scene/scene.h"
+#include "util/error.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <pthread.h>

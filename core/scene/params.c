@@ -1,12 +1,12 @@
 /* params.c — plugin parameter blocks: reading a plugin's keys from the scene against the plugin's
  * schema (types, ranges, choices, textures, required keys), for the scene loader (load.c) and the
  * media loader (media.c). */
-#include "params.h"
-#include "scene.h"
-#include "texture.h"
-#include "runtime.h"
-#include "util.h"
-#include "yread.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+#include "util/runtime.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include "murk/integrator.h"
 #include "murk/material.h"

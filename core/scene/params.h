@@ -8,8 +8,8 @@
 #include "murk/murk.h"
 #include "murk/medium.h"
 #include "murk/plugin.h"
-#include "plugin_loader.h"
-#include "yamldoc.h"
+#include "plugin/plugin_loader.h"
+#include "yaml/yamldoc.h"
 
 /* A parameter array of n values kept for the scene's lifetime (freed with the scene). */
 murk_value *murk_scene_keep_params(murk_scene *s, size_t n);

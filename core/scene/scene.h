@@ -9,8 +9,8 @@
 #include "murk/material.h"
 #include "murk/medium.h"
 #include "murk/murk.h"
-#include "plugin_loader.h"
-#include "yamldoc.h"
+#include "plugin/plugin_loader.h"
+#include "yaml/yamldoc.h"
 
 typedef enum { MURK_SHAPE_QUAD, MURK_SHAPE_SPHERE, MURK_SHAPE_BOX, MURK_SHAPE_MESH } murk_shape_type;
 

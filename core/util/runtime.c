@@ -1,7 +1,7 @@
 /* runtime.c — the run-time state libmurk's layers share (runtime.h): the log and its quiet switch, the
  * once-only warnings, and every thread's cost counters. */
-#include "runtime.h"
-#include "util.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <pthread.h>
 #include <stdarg.h>

@@ -1,5 +1,5 @@
 /* util.c — small helpers internal to libmurk. */
-#include "util.h"
+#include "util/util.h"
 
 #include <stdarg.h>
 #include <stdio.h>
