@@ -222,8 +222,8 @@ static size_t skip_keys(const murk_plugin_desc *d, const char **out, size_t cap)
 
 /* `transmittance: NAME` or `transmittance: { type: NAME, key: value, ... }`: the medium's estimator plugin,
  * its parameters checked against its schema like a tracker's, created on the medium's data. */
-static int load_estimator(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *n, murk_named_medium *nm, char *err,
-                          size_t errlen)
+static int load_estimator(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *n,
+                          murk_named_medium *nm, char *err, size_t errlen)
 {
     static const char *const skip[] = {"type"};
     const murk_ynode *t = n->kind == MURK_Y_MAP ? murk_ymap_get(n, "type") : n;
@@ -242,8 +242,8 @@ static int load_estimator(murk_scene *s, const murk_host *host, const char *name
     return 0;
 }
 
-static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
-                       size_t errlen)
+static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m,
+                       murk_named_medium *nm, char *err, size_t errlen)
 {
     char block[256], who[256];
     snprintf(block, sizeof block, "medium '%s'", name);
@@ -326,8 +326,8 @@ static int load_medium(murk_scene *s, const murk_host *host, const char *name, c
     for (size_t i = 0; i < MURK_MEDIUM_NCORE; i++)
         skip[nskip++] = murk_medium_core_params[i].name;
     const murk_plugin *p;
-    if (murk_scene_instantiate(s, host, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self, err,
-                               errlen))
+    if (murk_scene_instantiate(s, host, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self,
+                               err, errlen))
         return -1;
     nm->m.vt = p->desc->vtable;
     nm->m.name = nm->name;

@@ -22,10 +22,11 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
                                   const char *const *skip, size_t nskip, int note_drops, murk_value *values,
                                   char *err, size_t errlen);
 
-/* One plugin instance from a scene block, its create() called with the services table host — the only path by which the core instantiates plugins of
+/* One plugin instance from a scene block — the only path by which the core instantiates plugins of
  * any kind: finds the plugin `type` of `kind` on the search path (a refusal is reported at type_node),
  * reads its parameters from `map` (keys in skip[] belong to the caller; map may be a scalar, which
- * has none), and calls its create() (for media and transmittance estimators with `data`). `block`
+ * has none), and calls its create() with the services table `host` (for media and transmittance
+ * estimators with `data`). `block`
  * prefixes a refusal of the plugin ("material 'metal'"), `who` parameter and create() errors
  * ("material 'metal' (ggx)"). On success *plugin and *self are set (the parameters are kept with the
  * scene, as create()'s contract promises). */
