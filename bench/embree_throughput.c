@@ -51,10 +51,10 @@
  * end at the same t), so the ratio of flights/s is the ratio of tracker steps/s; the bare loop's steps
  * (tentative collisions + majorant cells) per second are printed too. Interleaved rounds as above, timed
  * in the thread's CPU seconds (CLOCK_THREAD_CPUTIME_ID). */
-#include "camera.h"
-#include "host.h"
-#include "scene.h"
-#include "util.h"
+#include "render/camera.h"
+#include "render/host.h"
+#include "scene/scene.h"
+#include "util/util.h"
 
 #include "murk/tracking.h"
 

@@ -1,11 +1,11 @@
-/* test_plugin_abi.c — the plugin loader (core/plugin.c) against the fixture plugins in
+/* test_plugin_abi.c — the plugin loader (core/plugin/plugin.c) against the fixture plugins in
  * tests/fixtures (built into the build's tests/fixtures folder, reached only through MURK_PLUGIN_PATH):
  * every refusal is rc -1 with one precise line naming the file; plugin code is never run before the
  * ABI check (abi_major/abi_minor/no_abi abort() if their entry is called); only the plugins a scene
  * names are loaded; `murk render` / `murk plugins` report the same; an empty MURK_PLUGIN_PATH entry
  * never means the current folder. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <dlfcn.h>
 #include <stdio.h>
@@ -14,8 +14,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "plugin_loader.h"
-#include "scene.h"
+#include "plugin/plugin_loader.h"
+#include "scene/scene.h"
 
 static char err[2048];
 

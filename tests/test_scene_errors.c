@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "murk/murk.h"
-#include "util.h"
+#include "util/util.h"
 
 typedef struct bad_scene {
     const char *name;

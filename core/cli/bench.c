@@ -2,15 +2,17 @@
  * every budget (--spp or --time) with --repeat seeds, measures each render against a reference
  * (metrics.c: the noise-corrected relMSE and the rest) and its work (the cost counters), writes
  * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
- * the charts and report.md. Also the counters' text forms (the end-of-render summary, murk:counters).
- * Part of the murk executable. */
-#include "atomic.h"
-#include "cli.h"
-#include "image.h"
-#include "media.h"
-#include "metrics.h"
-#include "scene.h"
-#include "util.h"
+ * the charts and report.md. Part of the murk executable. */
+#include "cli/cli.h"
+#include "cli/metrics.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "render/counters.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,90 +31,6 @@ static double now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t counter_get(const murk_counters *c, int k)
-{
-    const uint64_t v[MURK_NCOUNTERS] = {c->lookups, c->cells, c->collisions, c->scatters, c->shadow};
-    return v[k];
-}
-
-/* The media's counters summed. */
-static murk_counters counters_total(const murk_render_result *r)
-{
-    murk_counters t = {0};
-    for (int i = 0; i < r->nmedia; i++) {
-        t.lookups += r->media[i].lookups;
-        t.cells += r->media[i].cells;
-        t.collisions += r->media[i].collisions;
-        t.scatters += r->media[i].scatters;
-        t.shadow += r->media[i].shadow;
-    }
-    return t;
-}
-
-/* A medium's name for the counters: the scene's, or "(the rest)" for the shared last slot. */
-static const char *slot_name(const murk_scene *s, int i)
-{
-    return i == MURK_COUNTER_SLOTS - 1 && s->nmedia > MURK_COUNTER_SLOTS ? "(the rest)" : s->media[i].name;
-}
-
-static size_t json_counters(char *buf, size_t n, size_t k, const murk_counters *c)
-{
-    for (int i = 0; i < MURK_NCOUNTERS && k < n; i++)
-        k += (size_t)snprintf(buf + k, n - k, "%s\"%s\": %llu", i ? ", " : "{", counter_names[i],
-                              (unsigned long long)counter_get(c, i));
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, "}");
-    return k;
-}
-
-/* The media's counters as JSON: {"rays": N, "total": {...}, "media": {"NAME": {...}, ...}}; when the
- * names do not fit in buf, the rays and totals only. */
-void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n)
-{
-    murk_counters t = counters_total(r);
-    size_t head = (size_t)snprintf(buf, n, "{\"rays\": %llu, \"total\": ", (unsigned long long)r->rays);
-    size_t k = json_counters(buf, n, head, &t);
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, ", \"media\": {");
-    for (int i = 0; i < r->nmedia && k < n; i++) {
-        k += (size_t)snprintf(buf + k, n - k, "%s\"", i ? ", " : "");
-        for (const char *p = slot_name(s, i); *p && k < n; p++) { /* escape " \ and control characters */
-            unsigned char ch = (unsigned char)*p;
-            k += ch < 0x20 ? (size_t)snprintf(buf + k, n - k, "\\u%04x", ch)
-                           : (size_t)snprintf(buf + k, n - k, ch == '"' || ch == '\\' ? "\\%c" : "%c", ch);
-        }
-        if (k < n)
-            k += (size_t)snprintf(buf + k, n - k, "\": ");
-        k = json_counters(buf, n, k, &r->media[i]);
-    }
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, "}}");
-    if (k >= n) { /* too long: the totals alone */
-        k = json_counters(buf, n, head, &t);
-        if (k < n)
-            snprintf(buf + k, n - k, "}");
-    }
-}
-
-/* The end-of-render summary's counters: rays, then one line per medium (and their sum when several). */
-void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r)
-{
-    fprintf(f, "counters: %llu rays traced", (unsigned long long)r->rays);
-    for (int i = 0; i <= r->nmedia; i++) {
-        if (i == r->nmedia && r->nmedia < 2)
-            break;
-        murk_counters t = i < r->nmedia ? r->media[i] : counters_total(r);
-        if (i < r->nmedia)
-            fprintf(f, "\n  medium '%s':", murk_cli_q(slot_name(s, i)));
-        else
-            fprintf(f, "\n  all media:");
-        for (int k = 0; k < MURK_NCOUNTERS; k++)
-            fprintf(f, " %llu %s%s", (unsigned long long)counter_get(&t, k), counter_names[k],
-                    k + 1 < MURK_NCOUNTERS ? "," : "");
-    }
-    fputc('\n', f);
 }
 
 /* ---- murk bench ---------------------------------------------------------------------------- */
@@ -966,13 +884,13 @@ static int run_bench(const bench *b, int argc, char **argv)
                 } else if (failed == 0) {
                     murk_metrics m;
                     murk_metrics_compute(res.rgb, r.rgb, r.var, r.w, (murk_crop){0, 0, r.w, r.h}, &m, pix);
-                    murk_counters t = counters_total(&res);
+                    murk_counters t = murk_counters_total(&res);
                     fprintf(csv, "%d,", v);
                     csv_str(csv, label);
                     fprintf(csv, ",%g,%d,%d,%.6f,%llu", b->budgets[bi], 1 + k, res.spp, res.seconds,
                             (unsigned long long)res.rays);
                     for (int c = 0; c < MURK_NCOUNTERS; c++)
-                        fprintf(csv, ",%llu", (unsigned long long)counter_get(&t, c));
+                        fprintf(csv, ",%llu", (unsigned long long)murk_counters_get(&t, c));
                     fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m.mse, m.relmse, m.relmse_se,
                             m.relmse_raw, m.ref_noise, m.mare, (unsigned long long)(res.nonfinite + m.nonfinite),
                             res.max_sample);

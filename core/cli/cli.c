@@ -7,17 +7,20 @@
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "check.h"
-#include "cli.h"
-#include "density.h"
-#include "atomic.h"
-#include "image.h"
-#include "limit.h"
-#include "media.h"
-#include "mpi_job.h"
-#include "plugin_loader.h"
-#include "scene.h"
-#include "util.h"
+#include "check/check.h"
+#include "cli/cli.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/density.h"
+#include "media/media.h"
+#include "plugin/plugin_loader.h"
+#include "render/counters.h"
+#include "render/mpi_job.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -28,21 +31,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static const char usage_text[] =
-    "usage:\n"
-    "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
-    "              [--checkpoint FILE [--every S]] [--resume FILE] [--part I/N]\n"
-    "  mpirun -n N murk render ...          (one image over N processes)\n"
-    "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
-    "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
-    "  murk plugins [NAME]\n"
-    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
-    "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
-    "  murk check [--seed S] [--quick] PLUGIN...\n"
-    "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
-    "  murk help [COMMAND]      (or murk COMMAND --help)\n"
-    "  murk --version\n";
 
 /* `murk help COMMAND` and `murk COMMAND --help`: what each subcommand does and takes. */
 static const struct command_help {
@@ -142,31 +130,9 @@ static int wants_help(int argc, char **argv)
     return 0;
 }
 
-/* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
- * eight rotating buffers, so one message may quote several. */
-const char *murk_cli_q(const char *s)
-{
-    static char buf[8][1024];
-    static int k;
-    k = (k + 1) % 8;
-    return murk_printable(buf[k], sizeof buf[k], s);
-}
-
 #define q(s) murk_cli_q(s)
 #define cli_error(m) murk_cli_error(m)
 #define usage(m) murk_cli_usage(m)
-
-/* "murk: MESSAGE" for a message built from input (the scene's and loaders' errors are printable
- * already; plugin and image errors may quote a raw argument). */
-void murk_cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", murk_cli_q(msg)); }
-
-int murk_cli_usage(const char *msg)
-{
-    if (msg)
-        fprintf(stderr, "murk: %s\n", msg);
-    fputs(usage_text, stderr);
-    return 2;
-}
 
 static int parse_int_arg(const char *opt, const char *v, long lo, long hi, long *out)
 {
@@ -215,49 +181,6 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.2f k", v / 1e3);
     else
         snprintf(buf, n, "%.0f ", v);
-}
-
-/* SIGINT/SIGTERM/SIGHUP during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set
- * and murk goes on. render abandons the running pass, writes the image of the whole passes done
- * (murk:interrupted says so) and exits with 128 + the signal's number; bench (bench.c) stops after the
- * running render, keeps only whole renders' rows and exits the same way. A signal that was ignored when
- * murk started stays ignored: `nohup murk render ...` goes on rendering when its terminal hangs up, as
- * nohup promises, and a job a non-interactive shell started in the background keeps ignoring SIGINT. */
-static volatile sig_atomic_t render_stop, render_signal;
-
-static void on_stop_signal(int sig)
-{
-    render_signal = sig;
-    render_stop = 1;
-}
-
-volatile sig_atomic_t *murk_cli_catch_stop_signals(void)
-{
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
-        struct sigaction sa, old;
-        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
-            continue;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_stop_signal;
-        sigemptyset(&sa.sa_mask);
-        sigaction(sigs[i], &sa, NULL);
-    }
-    return &render_stop;
-}
-
-int murk_cli_stop_status(void) { return 128 + (render_signal ? (int)render_signal : SIGINT); }
-
-const char *murk_cli_stop_name(void)
-{
-    return render_signal == SIGTERM ? "SIGTERM" : render_signal == SIGHUP ? "SIGHUP" : "SIGINT";
-}
-
-/* Under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar. */
-int murk_cli_progress(void)
-{
-    const char *e = getenv("MURK_PROGRESS");
-    return isatty(STDERR_FILENO) || (e && !strcmp(e, "1"));
 }
 
 /* ---- render under MPI -------------------------------------------------------------------------
@@ -385,7 +308,7 @@ static int parse_part(const char *v, int *part, int *parts)
 
 static int render_main(int argc, char **argv)
 {
-    murk_cli_catch_stop_signals();
+    volatile sig_atomic_t *stop = murk_cli_catch_stop_signals();
     const char *scene_path = NULL, *out = NULL;
     const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
     size_t nsets = 0;
@@ -518,7 +441,7 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    opts.stop = &render_stop;
+    opts.stop = stop;
     murk_render_result res;
     if (murk_render_err(s, &opts, &res, err, sizeof err) != 0) {
         if (err[0])
@@ -552,7 +475,7 @@ static int render_main(int argc, char **argv)
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
     static char counters[16384];
-    murk_cli_counters_json(s, &res, counters, sizeof counters);
+    murk_counters_json(s, &res, counters, sizeof counters);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
@@ -587,7 +510,7 @@ static int render_main(int argc, char **argv)
         cli_error(err);
         rc = 1;
     }
-    if (res.interrupted || render_stop) /* also when the signal came during the writes and cut them short */
+    if (res.interrupted || *stop) /* also when the signal came during the writes and cut them short */
         rc = murk_cli_stop_status();
     if (rc == 0 && !quiet) {
         char sps[32], rps[32];
@@ -595,7 +518,7 @@ static int render_main(int argc, char **argv)
         human((double)res.rays / res.seconds, rps, sizeof rps);
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
-        murk_cli_counters_print(stdout, s, &res);
+        murk_counters_print(stdout, s, &res);
     }
     murk_warn_summary();
     if (res.nonfinite)
@@ -862,7 +785,7 @@ int murk_cli_main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
-        fputs(usage_text, stdout);
+        fputs(murk_cli_usage_text, stdout);
         return 0;
     }
     int known = 0;

@@ -3,11 +3,11 @@
  * bias test (mean difference, its standard error and z-score), the efficiency from the render time and
  * cost counters the EXR records, and two pictures of the difference: a heat map of |a - r| scaled to its
  * 99th percentile, and beside it a signed map on a fixed scale. Part of the murk executable. */
-#include "atomic.h"
-#include "cli.h"
-#include "image.h"
-#include "metrics.h"
-#include "util.h"
+#include "cli/cli.h"
+#include "cli/metrics.h"
+#include "image/image.h"
+#include "util/atomic.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>

@@ -5,7 +5,7 @@
 
 #include <stddef.h>
 
-#include "scene.h"
+#include "scene/scene.h"
 
 /* Vertex i of a triangle shape. */
 static inline murk_vec3 murk_shape_vertex(const murk_shape *sh, uint32_t i)

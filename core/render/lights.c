@@ -8,8 +8,8 @@
  * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
  * from points that see the rectangle under less than MIN_RECT_OMEGA or lie on its plane up to PLANE_EPS
  * (a hit on the light itself): those sample it by area, and murk_lights_pdf() follows the same rule. */
-#include "accel.h"
-#include "util.h"
+#include "render/accel.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>

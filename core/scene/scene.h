@@ -1,5 +1,5 @@
-/* scene.h — the scene as the core holds it after loading and validation (load.c loads it, scene.c frees
- * it). Internal to libmurk. */
+/* scene.h — the scene as the core holds it after loading and validation: data only (load/load.c builds
+ * it, load/free.c frees it). Internal to libmurk. */
 #ifndef MURK_SCENE_H
 #define MURK_SCENE_H
 
@@ -9,8 +9,8 @@
 #include "murk/material.h"
 #include "murk/medium.h"
 #include "murk/murk.h"
-#include "plugin_loader.h"
-#include "yamldoc.h"
+#include "plugin/plugin_loader.h"
+#include "yaml/yamldoc.h"
 
 typedef enum { MURK_SHAPE_QUAD, MURK_SHAPE_SPHERE, MURK_SHAPE_BOX, MURK_SHAPE_MESH } murk_shape_type;
 
@@ -96,20 +96,5 @@ struct murk_scene {
     RTCDevice device;
     RTCScene rtc;
 };
-
-/* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
- * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the
- * camera; did you mean media.OTHER?" (or "--set ...: ..." for one a --set made). murk_scene_load itself
- * refuses only those a --set made (a misspelt name): embedders may load media and materials to call
- * them directly. Returns 0, or -1 with err. */
-int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
-
-/* The content hash a checkpoint carries: the scene file and every file it loads (meshes, density
- * grids, image textures, as named after the --set overrides), each with its path; so a resume after
- * any of them changed is refused. 0 with err if one cannot be read. */
-uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
-
-/* Releases what a shape owns (its triangle arrays). */
-void murk_shape_free(murk_shape *sh);
 
 #endif

@@ -1,6 +1,7 @@
 /* limit.c — the limits murk enforces on input sizes, with their environment overrides (limit.h). */
-#include "limit.h"
-#include "util.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <pthread.h>

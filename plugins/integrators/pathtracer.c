@@ -11,6 +11,9 @@
  *
  * The functions with external linkage are hidden in the plugin (only the entry symbols are exported). */
 #include "pathtracer.h"
+#ifdef MURK_PT_TAP
+#include "pathtracer_tap.h"
+#endif
 
 #include <math.h>
 #include <stdio.h>
@@ -208,7 +211,8 @@ typedef struct path {
                       * radiance picks up entering a denser medium (for Russian roulette only) */
 } path;
 
-/* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h). */
+/* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h), which
+ * a build with the tap reports (pathtracer_tap.h). */
 static void add_light(path *st, murk_rgb le, float w, int term)
 {
     murk_rgb c = murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R));

@@ -69,21 +69,13 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
 murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
                         const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
 
-/* What each contribution add_light() makes to a sample is (bench/variance_profile's tap, compiled in only
- * with -DMURK_PT_TAP, never into the plugins): light sampling at a surface vertex, at a free-flight
- * medium vertex and at the equiangular vertex; emission found by BSDF sampling, by phase sampling, by
- * the camera ray itself; the background. And how each path ended. */
+/* The techniques the path tracer tells apart, one for each contribution it makes to a sample (its
+ * `term`): light sampling at a surface vertex, at a free-flight medium vertex and at the equiangular
+ * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background.
+ * And how a path ended. Only a build with the tap (-DMURK_PT_TAP, pathtracer_tap.h: bench/variance_profile,
+ * never the plugins) reports them. */
 enum { MURK_PT_TERM_SURFACE_NEE, MURK_PT_TERM_MEDIUM_NEE, MURK_PT_TERM_EQUIANGULAR_NEE, MURK_PT_TERM_BSDF_EMISSION,
        MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_NTERMS };
 enum { MURK_PT_END_ROULETTE, MURK_PT_END_MAX_DEPTH, MURK_PT_END_ABSORBED, MURK_PT_END_ESCAPED, MURK_PT_NENDS };
-#ifdef MURK_PT_TAP
-/* Provided by the program that compiles pathtracer.c with the tap: `value` (beta Le w / mean(R), what
- * L gains) of technique `term` after `depth` scattering events (an NEE's own vertex not counted); then,
- * at most once per path, how it ended after `depth` scattering events: Russian roulette, max_depth, a
- * free flight of weight 0 (absorbed), escaped to the background. A path that ends otherwise (a BSDF
- * sample that failed or weighed 0, a non-finite value, the watchdog) reports no end. */
-void murk_pt_tap(int depth, int term, murk_rgb value);
-void murk_pt_tap_end(int depth, int why);
-#endif
 
 #endif

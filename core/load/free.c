@@ -1,8 +1,9 @@
-/* scene.c — the scene data: what a loaded scene owns and how it is released (load.c builds it). */
-#include "scene.h"
-#include "media.h"
-#include "texture.h"
-#include "util.h"
+/* free.c — what a loaded scene owns and how it is released: murk_scene_free, the inverse of load.c's
+ * murk_scene_load (the scene's data, scene.h, sits below the media and render parts it frees). */
+#include "load/load.h"
+#include "media/media.h"
+#include "scene/texture.h"
+#include "util/util.h"
 
 #include <stdlib.h>
 

@@ -4,16 +4,16 @@
  * Every key is checked: the core's own blocks against the tables below, plugin blocks against the
  * plugin's parameter schema (params.c); the `media:` block is media.c's. Every error is one line
  * "file:line:col: what is wrong". */
-#include "scene.h"
-#include "accel.h"
-#include "checkpoint.h"
-#include "host.h"
-#include "limit.h"
-#include "media.h"
-#include "obj.h"
-#include "params.h"
-#include "util.h"
-#include "yread.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "render/accel.h"
+#include "render/checkpoint.h"
+#include "render/host.h"
+#include "scene/obj.h"
+#include "scene/params.h"
+#include "util/limit.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -173,7 +173,7 @@ static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t err
     return 0;
 }
 
-static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+static int load_materials(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     if (!n)
         return 0;
@@ -196,8 +196,8 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
         void *self;
         char who_type[512];
         snprintf(who_type, sizeof who_type, "%s (%s)", who, type);
-        if (murk_scene_instantiate(s, MURK_KIND_MATERIAL, t, type, m, who, who_type, skip, 1, NULL, &p, &self, err,
-                                   errlen))
+        if (murk_scene_instantiate(s, host, MURK_KIND_MATERIAL, t, type, m, who, who_type, skip, 1, NULL, &p, &self,
+                                   err, errlen))
             return -1;
         nm->name = murk_strdup(n->keys[i]);
         nm->m.vt = p->desc->vtable;
@@ -209,7 +209,7 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
     return 0;
 }
 
-static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+static int load_integrator(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     static const char *const skip[] = {"type"};
     static const murk_ynode empty = {.kind = MURK_Y_MAP, .file = "(default)", .line = 1, .col = 1};
@@ -227,8 +227,8 @@ static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t
     const murk_ynode *t = murk_ymap_get(n, "type");
     char who[256];
     snprintf(who, sizeof who, "integrator '%s'", type);
-    if (murk_scene_instantiate(s, MURK_KIND_INTEGRATOR, t ? t : n, type, n, "integrator", who, skip, 1, NULL, &p,
-                               &s->integrator, err, errlen))
+    if (murk_scene_instantiate(s, host, MURK_KIND_INTEGRATOR, t ? t : n, type, n, "integrator", who, skip, 1, NULL,
+                               &p, &s->integrator, err, errlen))
         return -1;
     const murk_integrator_vt *vt = p->desc->vtable;
     s->integrator_plugin = p;
@@ -554,6 +554,8 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return ERR(v, "scene format version %lld is not supported (this murk reads version 1)", ver);
     if (check_unused(root, 1, err, errlen))
         return -1;
+    /* the services table every plugin's create() receives, handed down to the blocks that create them */
+    const murk_host *host = murk_host_table();
     const murk_ynode *c;
     if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
         return -1;
@@ -562,14 +564,14 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     s->background = to_rgb(bg);
     if ((c = murk_ymap_get(root, "media"))) {
-        if (murk_media_load(s, c, err, errlen))
+        if (murk_media_load(s, host, c, err, errlen))
             return -1;
     }
     if (load_camera(s, murk_ymap_get(root, "camera"), err, errlen))
         return -1;
-    if (load_materials(s, murk_ymap_get(root, "materials"), err, errlen))
+    if (load_materials(s, host, murk_ymap_get(root, "materials"), err, errlen))
         return -1;
-    if (load_integrator(s, murk_ymap_get(root, "integrator"), err, errlen))
+    if (load_integrator(s, host, murk_ymap_get(root, "integrator"), err, errlen))
         return -1;
     if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen))
         return -1;
