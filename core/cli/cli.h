@@ -29,6 +29,7 @@ const char *murk_cli_stop_name(void);
 int murk_cli_progress(void);
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
+int murk_cli_plugins(int argc, char **argv); /* plugins.c */
 int murk_cli_bench(int argc, char **argv);   /* bench.c */
 
 /* The cost counters (murk/counters.h) of a render as JSON for the EXR's murk:counters, and as the
