@@ -155,7 +155,8 @@ static void md_params(const murk_param *ps, uint32_t n, const char *const *first
         const murk_param *q = &ps[i];
         char def[128], range[256], type[64];
         param_fields(q, def, sizeof def, range, sizeof range);
-        snprintf(type, sizeof type, "%s%s", type_name(q->type), (q->flags & MURK_PARAM_TEXTURABLE) ? " or texture" : "");
+        snprintf(type, sizeof type, "%s%s", type_name(q->type),
+                 (q->flags & MURK_PARAM_TEXTURABLE) ? " or texture" : "");
         md_row(q->name, type, (q->flags & MURK_PARAM_REQUIRED) ? "required" : def, range, q->doc);
     }
     if (last)
