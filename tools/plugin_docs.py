@@ -59,7 +59,7 @@ def main():
     ap.add_argument("--check", action="store_true", help="compare only; exit 1 if a file is stale")
     ap.add_argument("files", nargs="*", help="files relative to the repository (default: %s)" % ", ".join(FILES))
     a = ap.parse_args()
-    stale, cache = [], {}
+    stale, missing, cache = [], [], {}
     for name in a.files or FILES:
         path = os.path.join(ROOT, name)
         with open(path, encoding="utf-8") as f:
@@ -67,7 +67,7 @@ def main():
         new, n = regenerate(old, a.murk, cache)
         if n == 0:
             print(f"plugin_docs: {name} has no generated block (its markers were removed?)", file=sys.stderr)
-            stale.append(name)
+            missing.append(name)
         elif new != old and a.check:
             sys.stdout.writelines(difflib.unified_diff(old.splitlines(True), new.splitlines(True),
                                                        "a/" + name, "b/" + name))
@@ -79,7 +79,7 @@ def main():
     if stale:
         print(f"plugin_docs: {', '.join(stale)} out of date with the plugins' schemas: run "
               f"/usr/bin/python3 tools/plugin_docs.py (after building) and commit the result", file=sys.stderr)
-    return 1 if stale else 0
+    return 1 if stale or missing else 0
 
 
 if __name__ == "__main__":
