@@ -15,10 +15,19 @@
 enum { DOC_INDENT = 8, DOC_WIDTH = 100 }; /* text: a parameter's doc under its line, wrapped */
 
 /* The medium keys the core reads apart from its schema (murk_medium_special_keys): a map and a name. */
-static const char *const density_key[3] = {"density", "map", "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | "
-                                                             "{ cloud: { ... } }"};
-static const char *const transmittance_key[3] = {"transmittance", "name", "shadow-ray estimator: NAME or { type: "
-                                                                          "NAME, ... } (default: the tracker's own)"};
+typedef struct special_key {
+    const char *name, *type, *doc;
+} special_key;
+static const special_key density_key = {
+    .name = "density",
+    .type = "map",
+    .doc = "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }",
+};
+static const special_key transmittance_key = {
+    .name = "transmittance",
+    .type = "name",
+    .doc = "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)",
+};
 
 static const char *type_name(uint32_t t)
 {
@@ -88,18 +97,18 @@ static void print_params(const murk_param *ps, uint32_t n)
     }
 }
 
-static void print_key(const char *const key[3])
+static void print_key(const special_key *key)
 {
-    printf("    %-19s %s\n", key[0], key[1]);
-    print_wrapped(key[2]);
+    printf("    %-19s %s\n", key->name, key->type);
+    print_wrapped(key->doc);
 }
 
 static void medium_keys_text(void)
 {
     printf("  medium keys (read by the core, for every tracker):\n");
-    print_key(density_key);
+    print_key(&density_key);
     print_params(murk_medium_core_params, MURK_MEDIUM_NCORE);
-    print_key(transmittance_key);
+    print_key(&transmittance_key);
 }
 
 /* keys: whether a medium's section lists the medium keys (--all lists them once, before the first) */
@@ -146,11 +155,11 @@ static void md_row(const char *name, const char *type, const char *def, const ch
     fputs(" |\n", stdout);
 }
 
-static void md_params(const murk_param *ps, uint32_t n, const char *const *first, const char *const *last)
+static void md_params(const murk_param *ps, uint32_t n, const special_key *first, const special_key *last)
 {
     printf("| parameter | type | default | range | what |\n|---|---|---|---|---|\n");
     if (first)
-        md_row(first[0], first[1], "", "", first[2]);
+        md_row(first->name, first->type, "", "", first->doc);
     for (uint32_t i = 0; i < n; i++) {
         const murk_param *q = &ps[i];
         char def[128], range[256], type[64];
@@ -160,12 +169,12 @@ static void md_params(const murk_param *ps, uint32_t n, const char *const *first
         md_row(q->name, type, (q->flags & MURK_PARAM_REQUIRED) ? "required" : def, range, q->doc);
     }
     if (last)
-        md_row(last[0], last[1], "", "", last[2]);
+        md_row(last->name, last->type, "", "", last->doc);
 }
 
 static void medium_keys_md(void)
 {
-    md_params(murk_medium_core_params, MURK_MEDIUM_NCORE, density_key, transmittance_key);
+    md_params(murk_medium_core_params, MURK_MEDIUM_NCORE, &density_key, &transmittance_key);
 }
 
 static void describe_md(const murk_plugin *p, int keys)
