@@ -1,7 +1,7 @@
 /* cli.c — the murk command line:
  *   murk render SCENE.yaml [-o out.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S]
  *   murk info SCENE.yaml [--set KEY.PATH=VALUE ...]   (info.c)
- *   murk plugins [NAME]
+ *   murk plugins [--markdown] [--all | NAME]   (plugins.c)
  *   murk compare A.exr B.exr [--diff d.png]
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
@@ -22,7 +22,6 @@
 #include "util/runtime.h"
 #include "util/util.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -60,10 +59,13 @@ static const struct command_help {
      "the materials, the shapes (with their material, interior and exterior) and the plugins each uses with the\n"
      "file each was loaded from. Renders nothing.\n"},
     {"plugins",
-     "usage: murk plugins [NAME]\n"
+     "usage: murk plugins [--markdown] [--all | NAME]\n"
      "Without NAME: lists every plugin on the search path ($MURK_PLUGIN_PATH, then the build's or the installed\n"
      "plugin folder) with its kind, description and file. With NAME: that plugin's parameters, their types,\n"
-     "defaults and ranges (for a tracker also the keys every medium has).\n"},
+     "defaults, ranges and descriptions (for a tracker also the keys every medium has).\n"
+     "  --all        every plugin's parameters (a name found twice: the first, as a scene loads it)\n"
+     "  --markdown   markdown tables instead of text, without files or versions: the list, or with NAME or\n"
+     "               --all the parameters (what tools/plugin_docs.py writes into README.md and docs/plugins.md)\n"},
     {"compare",
      "usage: murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
      "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) with its standard error, the mean absolute relative error,\n"
@@ -532,130 +534,6 @@ static int render_main(int argc, char **argv)
     return rc;
 }
 
-/* ---- plugins ------------------------------------------------------------------------------- */
-
-static const char *type_name(uint32_t t)
-{
-    static const char *const names[] = {"?", "float", "int", "bool", "rgb", "string", "enum"};
-    return t <= MURK_PARAM_ENUM ? names[t] : "?";
-}
-
-static void print_params(const murk_param *ps, uint32_t n)
-{
-    for (uint32_t i = 0; i < n; i++) {
-        const murk_param *q = &ps[i];
-        char def[128], range[96] = "";
-        switch (q->type) {
-        case MURK_PARAM_RGB:
-            snprintf(def, sizeof def, "[%g, %g, %g]", q->def[0], q->def[1], q->def[2]);
-            break;
-        case MURK_PARAM_BOOL:
-            snprintf(def, sizeof def, "%s", q->def[0] != 0 ? "true" : "false");
-            break;
-        case MURK_PARAM_STRING:
-        case MURK_PARAM_ENUM:
-            snprintf(def, sizeof def, "%s", q->def_str ? q->def_str : "");
-            break;
-        default:
-            snprintf(def, sizeof def, "%g", q->def[0]);
-        }
-        if (q->type == MURK_PARAM_ENUM)
-            snprintf(range, sizeof range, "one of %s", q->choices);
-        else if (q->type != MURK_PARAM_STRING && q->type != MURK_PARAM_BOOL)
-            snprintf(range, sizeof range, "[%g, %g]", q->min, q->max);
-        printf("    %-19s %-6s default %-18s %-22s %s%s%s\n", q->name, type_name(q->type), def, range, q->doc,
-               (q->flags & MURK_PARAM_TEXTURABLE) ? " (texturable)" : "", (q->flags & MURK_PARAM_REQUIRED) ? " (required)" : "");
-    }
-}
-
-static void describe(const murk_plugin *p)
-{
-    const murk_plugin_desc *d = p->desc;
-    printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description,
-           p->path, p->version ? p->version : "none", p->abi.major, p->abi.minor);
-    if (d->kind == MURK_KIND_MEDIUM) {
-        printf("  medium keys (read by the core, for every tracker):\n");
-        printf("    %-19s %-6s %s\n", "density", "map", "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }");
-        print_params(murk_medium_core_params, MURK_MEDIUM_NCORE);
-        printf("    %-19s %-6s %s\n", "transmittance", "name",
-               "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)");
-    }
-    if (d->kind == MURK_KIND_TRANSMITTANCE)
-        printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name, d->name);
-    if (!d->nparams) {
-        printf("  no parameters of its own\n");
-        return;
-    }
-    printf("  parameters:\n");
-    print_params(d->params, d->nparams);
-}
-
-static int cmd_plugins(int argc, char **argv)
-{
-    murk_registry reg;
-    murk_registry_init(&reg);
-    char err[1024];
-    int rc = 0;
-    if (argc > 1 || (argc == 1 && argv[0][0] == '-')) {
-        murk_registry_free(&reg);
-        if (argc == 1)
-            fprintf(stderr, "murk: unknown plugins option '%s'\n", q(argv[0]));
-        return usage(argc > 1 ? "plugins takes at most one name" : NULL);
-    }
-    if (argc == 1) {
-        const murk_plugin *p = murk_registry_load(&reg, 0, argv[0], err, sizeof err);
-        if (p)
-            describe(p);
-        else {
-            cli_error(err);
-            rc = 1;
-        }
-        murk_registry_free(&reg);
-        return rc;
-    }
-    for (size_t i = 0; i < reg.ndirs; i++) {
-        DIR *d = opendir(reg.dirs[i]);
-        if (!d)
-            continue;
-        struct dirent *e;
-        char **names = NULL;
-        size_t nn = 0;
-        while ((e = readdir(d))) {
-            size_t l = strlen(e->d_name);
-            if (l > 3 && strcmp(e->d_name + l - 3, ".so") == 0) {
-                names = murk_xrealloc(names, (nn + 1) * sizeof *names);
-                names[nn++] = murk_strdup(e->d_name);
-            }
-        }
-        closedir(d);
-        for (size_t a = 0; a < nn; a++) /* sorted listing */
-            for (size_t b = a + 1; b < nn; b++)
-                if (strcmp(names[b], names[a]) < 0) {
-                    char *t = names[a];
-                    names[a] = names[b];
-                    names[b] = t;
-                }
-        for (size_t k = 0; k < nn; k++) {
-            size_t n = strlen(reg.dirs[i]) + strlen(names[k]) + 2;
-            char *path = murk_xmalloc(n);
-            snprintf(path, n, "%s/%s", reg.dirs[i], names[k]);
-            murk_plugin p;
-            if (murk_plugin_open(path, 0, &p, err, sizeof err) == 0) {
-                printf("%-10s %-16s %-58s %s\n", murk_kind_name((int)p.desc->kind), p.desc->name, p.desc->description,
-                       path);
-                murk_plugin_close(&p);
-            } else {
-                printf("%-10s %-16s %s\n", "(broken)", names[k], err);
-            }
-            free(path);
-            free(names[k]);
-        }
-        free(names);
-    }
-    murk_registry_free(&reg);
-    return rc;
-}
-
 /* ---- grid ---------------------------------------------------------------------------------- */
 
 /* A number read as strictly as the scene's (yread.c): a whole decimal token, no leading space, no hex,
@@ -800,7 +678,7 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "info"))
         return murk_cli_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "plugins"))
-        return cmd_plugins(argc - 2, argv + 2);
+        return murk_cli_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return murk_cli_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench"))

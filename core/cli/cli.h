@@ -30,6 +30,7 @@ const char *murk_cli_stop_name(void);
 int murk_cli_progress(void);
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
+int murk_cli_plugins(int argc, char **argv); /* plugins.c */
 int murk_cli_bench(int argc, char **argv);   /* bench.c */
 
 /* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */

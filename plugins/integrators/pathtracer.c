@@ -20,21 +20,43 @@
 
 #include "murk/material.h"
 
+/* Each parameter's only description (murk plugins NAME prints it; docs/plugins.md is generated from it). */
 #define PT_SHARED_PARAMS \
     [MURK_PT_MAX_DEPTH] = {"max_depth", MURK_PARAM_INT, 0, {64, 0, 0}, NULL, NULL, 1, 100000, \
-                           "most scattering events (surface or medium) per path"}, \
+                           "the most scattering events (surface bounces and, in volpath and volpath_nee, medium " \
+                           "scattering) a path may take; light found after the last one still counts, so 1 is " \
+                           "direct light only"}, \
     [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000, \
-                          "scattering events before Russian roulette may end a path"}, \
+                          "scattering events before Russian roulette may end a path; survivors are divided by " \
+                          "their survival probability, so roulette adds noise but no bias"}, \
     [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0, \
-                                "NEE: every light triangle by area, or rectangular lights by solid angle"}, \
+                                "how next-event estimation picks a point on a light: area, every emitting " \
+                                "triangle uniformly by area (a rectangular quad or box face as its whole " \
+                                "rectangle); solid_angle, a rectangular quad or box face uniformly in the solid " \
+                                "angle it subtends (Urena et al. 2013; tiny ones and other shapes by area). " \
+                                "solid_angle is far less noisy for points close to a light but costs more per " \
+                                "sample, and at equal time it was at best even with area (docs/results.md, " \
+                                "\"Light sampling\"), so area is the default. Both render the same image " \
+                                "(tests/test_lights.c)"}, \
     [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1, \
-                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
+                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold), at " \
+                              "least 0.05: 1 plays with every path whose weight fell below 1, 0.1 (Tungsten's " \
+                              "rule) only with the paths below a tenth: longer paths and less noise per sample, " \
+                              "but no better per second (docs/results.md)"},
 
 const murk_param murk_pt_params[MURK_PT_NPARAMS] = {PT_SHARED_PARAMS};
 const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
     PT_SHARED_PARAMS
     [MURK_PT_EQUIANGULAR] = {"equiangular", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
-                             "also sample each medium segment equiangularly towards a light point (MIS)"},
+                             "also sample each medium segment equiangularly (Kulla and Fajardo 2012) towards a "
+                             "reference point on a light, and combine that vertex's NEE with the free flight's "
+                             "by MIS (the balance heuristic; a per-segment exponential stands in for the free "
+                             "flight's pdf, exact in a grey homogeneous medium and an approximation elsewhere, "
+                             "which changes the noise, never the image). Free flights are untouched. It pays off "
+                             "where single scattering of a light dominates and free flights rarely scatter near "
+                             "it (a lamp in or beside thin fog: scenes/fog_lamp.yaml); it costs more per sample, "
+                             "is about even in an optically thin-to-moderate medium and loses in a dense cloud "
+                             "(docs/results.md, \"Equiangular sampling\"), so it is off by default"},
 };
 
 /* The plugin's name, for the watchdog's reports. */

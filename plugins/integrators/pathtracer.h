@@ -34,7 +34,7 @@
 #include "murk/integrator.h"
 #include "murk/medium.h"
 
-/* The parameters all three integrators share (documented in each plugin's comment block). */
+/* The parameters all three integrators share (described in their schema entries, pathtracer.c). */
 enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 /* volpath_nee's: the shared ones, then its own. */

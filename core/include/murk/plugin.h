@@ -103,7 +103,8 @@ typedef struct murk_param {
     const char *def_str; /* default for STRING and ENUM */
     const char *choices; /* ENUM only: "max|average|history" */
     double min, max;  /* inclusive range for numbers and every RGB component */
-    const char *doc;  /* one line, shown by `murk plugins NAME` */
+    const char *doc;  /* the parameter's description, one paragraph without line breaks (any length:
+                       * `murk plugins NAME` wraps it; `--markdown` puts it in a table cell) */
 } murk_param;
 
 typedef struct murk_texture murk_texture; /* opaque; evaluated through murk_host.tex_eval */
