@@ -55,6 +55,7 @@
  *
  * Robustness: |wo.z| or |wi.z| below 1e-9 gives f = 0, pdf = 0 and no sample; every output is finite. */
 #include "murk/material.h"
+#include "murk/microfacet.h"
 
 #include <string.h>
 
@@ -101,33 +102,14 @@ typedef struct di_shade {
     murk_rgb tint;
 } di_shade;
 
-static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
-
 static void shade_at(const dielectric *d, const murk_hit *hit, di_shade *sh)
 {
     float v[3];
     murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
-    float r = clamp01(v[0]);
+    float r = murk_clamp01(v[0]);
     sh->alpha = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
     murk_value_eval(d->host, &d->p[P_TINT], hit, v);
-    sh->tint = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
-}
-
-/* Unpolarised Fresnel reflectance for the cosine ci of the incident direction with the normal (negative:
- * from inside) and the relative index eta (inside / outside). 1 under total internal reflection. */
-static float fresnel(float ci, float eta)
-{
-    ci = ci > 1.0f ? 1.0f : (ci < -1.0f ? -1.0f : ci);
-    if (ci < 0.0f) {
-        eta = 1.0f / eta;
-        ci = -ci;
-    }
-    float s2t = (1.0f - ci * ci) / (eta * eta);
-    if (s2t >= 1.0f)
-        return 1.0f;
-    float ct = sqrtf(1.0f - s2t);
-    float rpa = (eta * ci - ct) / (eta * ci + ct), rpe = (ci - eta * ct) / (ci + eta * ct);
-    return 0.5f * (rpa * rpa + rpe * rpe);
+    sh->tint = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
 }
 
 /* Refraction of w (pointing away from the surface) through normal n with relative index eta (the side
@@ -147,37 +129,6 @@ static int refract(murk_vec3 w, murk_vec3 n, float eta, float *etap, murk_vec3 *
     *wt = murk_normalize(murk_add(murk_mul(w, -1.0f / eta), murk_mul(n, ci / eta - ct)));
     *etap = eta;
     return 1;
-}
-
-static float ggx_D(murk_vec3 m, float a2)
-{
-    float d = a2 * m.z * m.z + (m.x * m.x + m.y * m.y);
-    return a2 / (MURK_PI * d * d);
-}
-static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); } /* |mu| sqrt(1 + a2 tan^2) */
-/* G2 / (|mu_o| |mu_i|), height-correlated Smith */
-static float g2_over(float muo, float mui, float a2)
-{
-    muo = fabsf(muo);
-    mui = fabsf(mui);
-    return 2.0f / (mui * ggx_R(muo, a2) + muo * ggx_R(mui, a2));
-}
-/* G1(w) / |w.z| */
-static float g1_over(float mu, float a2)
-{
-    mu = fabsf(mu);
-    return 2.0f / (mu + ggx_R(mu, a2));
-}
-
-/* Visible GGX normal for wo with wo.z > 0, spherical caps (Dupuy & Benyoub 2023), as in ggx.c. */
-static murk_vec3 sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
-{
-    murk_vec3 ws = murk_normalize(murk_v3(alpha * wo.x, alpha * wo.y, wo.z));
-    float phi = 2.0f * MURK_PI * u0;
-    float z = (1.0f - u1) * (1.0f + ws.z) - ws.z;
-    float st = sqrtf(clamp01(1.0f - z * z));
-    murk_vec3 hs = murk_v3(st * cosf(phi) + ws.x, st * sinf(phi) + ws.y, z + ws.z);
-    return murk_normalize(murk_v3(alpha * hs.x, alpha * hs.y, murk_maxf(hs.z, 0.0f)));
 }
 
 static int usable(float z) { return fabsf(z) >= DI_MU_MIN; } /* NaN -> 0 */
@@ -215,7 +166,7 @@ typedef struct ms_at {
 static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
 {
     float e0 = ms_row(t, side, m->j, mu), e1 = ms_row(t, side, m->j + 1, mu);
-    return clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
+    return murk_clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
 }
 
 /* The lobe (Kulla & Conty 2017's dielectric extension). Sides: o outside (index 1), i inside (index
@@ -252,7 +203,7 @@ static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float m
         return;
     }
     float ts = side ? tf * ao / (eta * eta * sum) : tf * ai / sum;
-    m->r = clamp01(1.0f - ts);
+    m->r = murk_clamp01(1.0f - ts);
     m->kr = as > 1e-7f ? m->r / (MURK_PI * as) : 0.0f; /* kt alone keeps transmission reciprocal */
     m->kt = tf / (MURK_PI * sum);
 }
@@ -275,20 +226,20 @@ static int rough_one(const di_ms *ms, float eta, float alpha, murk_vec3 wo, murk
             wm = murk_neg(wm);
         float dwi = murk_dot(wm, wi), dwo = murk_dot(wm, wo);
         if (dwi * ci > 0.0f && dwo * co > 0.0f) {
-            float D = ggx_D(wm, a2);
+            float D = murk_ggx_d(wm, a2);
             /* a transmitted pair's Fresnel from the outside direction's cosine, whichever of wo and wi it
              * is: the same number as from inside, but without the cancellation in 1 - sin^2 near the
              * critical angle, so f stays reciprocal to float precision */
-            float F = fresnel(reflect || co > 0.0f ? dwo : dwi, eta);
-            float dwo_pdf = g1_over(co, a2) * D * fabsf(dwo); /* D_wo(wm) */
+            float F = murk_fresnel_dielectric(reflect || co > 0.0f ? dwo : dwi, eta);
+            float dwo_pdf = murk_ggx_vndf_pdf(wo, wm, a2); /* D_wo(wm) */
             if (reflect) {
-                *f = D * F * 0.25f * g2_over(co, ci, a2);
+                *f = D * F * 0.25f * murk_ggx_g2_over_mu2(co, ci, a2);
                 *pdf = dwo_pdf * F / (4.0f * fabsf(dwo));
             } else {
                 float s = dwi + dwo / etap, den = s * s;
                 if (den > 0.0f) {
                     float T = 1.0f - F;
-                    *f = D * T * g2_over(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
+                    *f = D * T * murk_ggx_g2_over_mu2(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
                     *pdf = dwo_pdf * T * fabsf(dwi) / den;
                 }
             }
@@ -365,7 +316,7 @@ static void ms_build(di_ms *t, double eta)
     double sum = 0.0;
     enum { NF = 4096 };
     for (int i = 0; i < NF; i++) /* integral of F d(mu^2) */
-        sum += fresnel(sqrtf((float)((i + 0.5) / NF)), (float)eta);
+        sum += murk_fresnel_dielectric(sqrtf((float)((i + 0.5) / NF)), (float)eta);
     t->favg = (float)(sum / NF);
 }
 
@@ -457,7 +408,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     }
     float eta = d->eta[ch];
     if (!(sh.alpha > 0.0f)) { /* smooth: two delta lobes */
-        float R = fresnel(wo.z, eta), T = 1.0f - R;
+        float R = murk_fresnel_dielectric(wo.z, eta), T = 1.0f - R;
         float w;
         if (uc < R) {
             s->wi = murk_v3(-wo.x, -wo.y, wo.z);
@@ -500,10 +451,10 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     }
     if (!lobe_ms) { /* a visible normal of wo (of -wo when wo is inside), then Fresnel's choice */
         murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
-        murk_vec3 wm = sample_vndf(wv, sh.alpha, u[0], u[1]);
-        float R = fresnel(murk_dot(wo, wm), eta);
+        murk_vec3 wm = murk_ggx_sample_vndf(wv, sh.alpha, u[0], u[1]);
+        float R = murk_fresnel_dielectric(murk_dot(wo, wm), eta);
         if (uc < R) {
-            wi = murk_normalize(murk_sub(murk_mul(wm, 2.0f * murk_dot(wo, wm)), wo));
+            wi = murk_reflect(wo, wm);
             if (wi.z * wo.z <= 0.0f)
                 return 0;
         } else {

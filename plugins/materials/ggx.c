@@ -72,6 +72,7 @@
  * returns 0 there and for rejected or zero-pdf samples. No formula divides by mu or tan theta alone, so
  * grazing directions (wo.z = 1e-7) stay finite, and with alpha >= 0.001 every output is bounded. */
 #include "murk/material.h"
+#include "murk/microfacet.h"
 
 #include <string.h>
 
@@ -119,23 +120,22 @@ typedef struct ggx_shade {
     float xavg[3]; /* average of X (the coat's energy bound), per channel */
 } ggx_shade;
 
-static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
-static int above(float z) { return z >= GGX_MU_MIN; }                                /* NaN -> 0 */
+static int above(float z) { return z >= GGX_MU_MIN; } /* NaN -> 0 */
 
 static void ggx_shade_at(const ggx *g, const murk_hit *hit, ggx_shade *sh)
 {
     float v[3];
     murk_value_eval(g->host, &g->p[P_ALBEDO], hit, v);
-    sh->albedo = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
+    sh->albedo = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
     murk_value_eval(g->host, &g->p[P_SPECULAR], hit, v);
-    sh->f0 = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
+    sh->f0 = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
     float a;
     if (g->use_alpha) {
         murk_value_eval(g->host, &g->p[P_ALPHA], hit, v);
-        a = clamp01(v[0]);
+        a = murk_clamp01(v[0]);
     } else {
         murk_value_eval(g->host, &g->p[P_ROUGHNESS], hit, v);
-        float rough = clamp01(v[0]);
+        float rough = murk_clamp01(v[0]);
         a = rough * rough;
     }
     sh->alpha = a > GGX_ALPHA_MIN ? a : GGX_ALPHA_MIN;
@@ -182,13 +182,13 @@ static float tab_lookup(const float tab[GGX_TAB_N][GGX_TAB_N], float t01, float 
 }
 
 /* M(mu, alpha), mu in [0, 1], on the table's axis t = sqrt(mu). */
-static float ggx_m_lookup(const ggx_shade *sh, float mu) { return tab_lookup(ggx_m, sqrtf(clamp01(mu)), sh->r); }
+static float ggx_m_lookup(const ggx_shade *sh, float mu) { return tab_lookup(ggx_m, sqrtf(murk_clamp01(mu)), sh->r); }
 
 /* E(mu, alpha), mu in [0, 1], on the table's axis w = mu (1 + alpha) / (mu + alpha). */
 static float ggx_e_lookup(const ggx_shade *sh, float mu)
 {
-    mu = clamp01(mu);
-    return tab_lookup(ggx_e, clamp01(mu * (1.0f + sh->alpha) / (mu + sh->alpha)), sh->r);
+    mu = murk_clamp01(mu);
+    return tab_lookup(ggx_e, murk_clamp01(mu * (1.0f + sh->alpha) / (mu + sh->alpha)), sh->r);
 }
 
 /* Compensated model at one cosine: e = E(mu), and per channel the coat's energy bound
@@ -251,15 +251,6 @@ static float ggx_pspec_at(const ggx_shade *sh, float mu_o)
     return sh->ms ? ggx_pspec_ms(sh, mu_o) : ggx_pspec(sh, ggx_m_lookup(sh, mu_o));
 }
 
-static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); }
-
-/* GGX D for the unit half vector h (h.z > 0). Bounded by 1 / (pi alpha^2). */
-static float ggx_D(murk_vec3 h, float a2)
-{
-    float d = a2 * h.z * h.z + (h.x * h.x + h.y * h.y);
-    return a2 / (MURK_PI * d * d);
-}
-
 /* Unit half vector of wo and wi (both above the horizon); 0 if they are (nearly) opposite. */
 static int ggx_half(murk_vec3 wo, murk_vec3 wi, murk_vec3 *h)
 {
@@ -299,13 +290,11 @@ static murk_rgb ggx_eval_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     murk_vec3 h;
     if (ggx_half(wo, wi, &h)) {
         float a2 = sh->alpha * sh->alpha;
-        float dv = ggx_D(h, a2) * 0.5f / (mu_i * ggx_R(mu_o, a2) + mu_o * ggx_R(mu_i, a2));
-        float c = clamp01(murk_dot(wo, h));
-        float x = 1.0f - c, x2 = x * x, x5 = x2 * x2 * x;
-        for (int k = 0; k < 3; k++) {
-            float fr = sh->f0.c[k] + (1.0f - sh->f0.c[k]) * x5;
-            f.c[k] += fr * dv;
-        }
+        /* F D V, V = G2 / (4 mu_o mu_i) */
+        float dv = murk_ggx_d(h, a2) * 0.5f / murk_ggx_g2_den(mu_o, mu_i, a2);
+        float c = murk_clamp01(murk_dot(wo, h));
+        for (int k = 0; k < 3; k++)
+            f.c[k] += murk_fresnel_schlick(sh->f0.c[k], c) * dv;
     }
     return f;
 }
@@ -321,24 +310,9 @@ static float ggx_pdf_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     if (ps > 0.0f && ggx_half(wo, wi, &h)) {
         float a2 = sh->alpha * sh->alpha;
         /* D_wo(h) / (4 wo.h) = G1(wo) D(h) / (4 mu_o), G1 = 2 mu_o / (mu_o + R(mu_o)) */
-        pdf += ps * ggx_D(h, a2) * 0.5f / (mu_o + ggx_R(mu_o, a2));
+        pdf += ps * murk_ggx_d(h, a2) * 0.5f / (mu_o + murk_ggx_smith_r(mu_o, a2));
     }
     return pdf;
-}
-
-/* Visible GGX normal for wo (wo.z > 0), spherical caps (Dupuy & Benyoub 2023). */
-static murk_vec3 ggx_sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
-{
-    /* to the hemisphere configuration (alpha = 1) */
-    murk_vec3 ws = murk_normalize(murk_v3(alpha * wo.x, alpha * wo.y, wo.z));
-    /* uniform point on the unit sphere's cap z in (-ws.z, 1]; the half vector of it and ws is a
-     * visible normal of the hemisphere configuration */
-    float phi = 2.0f * MURK_PI * u0;
-    float z = (1.0f - u1) * (1.0f + ws.z) - ws.z;
-    float st = sqrtf(clamp01(1.0f - z * z));
-    murk_vec3 hs = murk_v3(st * cosf(phi) + ws.x, st * sinf(phi) + ws.y, z + ws.z);
-    /* back to the ellipsoid configuration */
-    return murk_normalize(murk_v3(alpha * hs.x, alpha * hs.y, fmaxf(hs.z, 0.0f)));
 }
 
 /* ---- Plugin interface ---------------------------------------------------------------------- */
@@ -394,11 +368,10 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
     float ps = ggx_pspec_at(&sh, fminf(wo.z, 1.0f));
     murk_vec3 wi;
     if (u[2] < ps) {
-        murk_vec3 h = ggx_sample_vndf(wo, sh.alpha, u[0], u[1]);
-        float c = murk_dot(wo, h);
-        if (!(c > 0.0f))
+        murk_vec3 h = murk_ggx_sample_vndf(wo, sh.alpha, u[0], u[1]);
+        if (!(murk_dot(wo, h) > 0.0f))
             return 0;
-        wi = murk_normalize(murk_sub(murk_mul(h, 2.0f * c), wo));
+        wi = murk_reflect(wo, h);
     } else {
         float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1];
         wi = murk_v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
