@@ -97,14 +97,17 @@ typedef struct dielectric {
     di_ms tab[3];   /* per channel (only [0] when not dispersive) */
 } dielectric;
 
+/* Parameter values at one hit. */
 typedef struct di_shade {
     float alpha; /* 0: smooth */
     murk_rgb tint;
+    int inside;  /* wo is inside (murk_material_wo_inside): the oriented frame flips z */
 } di_shade;
 
 static void shade_at(const dielectric *d, const murk_hit *hit, di_shade *sh)
 {
     float v[3];
+    sh->inside = murk_material_wo_inside(hit);
     murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
     float r = murk_clamp01(v[0]);
     sh->alpha = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
@@ -349,9 +352,9 @@ static void di_destroy(void *self)
 
 /* murk's frame (+z on wo's side) to the oriented one (+z outside) and back: the model is isotropic, so
  * flipping z is all it takes. */
-static int orient(const murk_hit *hit, murk_vec3 *wo, murk_vec3 *wi)
+static int orient(const di_shade *sh, murk_vec3 *wo, murk_vec3 *wi)
 {
-    if (!murk_material_wo_inside(hit))
+    if (!sh->inside)
         return 0;
     wo->z = -wo->z;
     if (wi)
@@ -359,46 +362,51 @@ static int orient(const murk_hit *hit, murk_vec3 *wo, murk_vec3 *wi)
     return 1;
 }
 
-static murk_rgb di_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static void di_prepare(const void *self, const murk_hit *hit, murk_shading *sp)
 {
-    orient(hit, &wo, &wi);
-    di_shade sh;
-    shade_at(self, hit, &sh);
+    _Static_assert(sizeof(di_shade) <= MURK_SHADING_BYTES, "di_shade fits a murk_shading");
+    shade_at(self, hit, (di_shade *)sp->data.bytes);
+}
+
+static murk_rgb di_eval_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
+{
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    orient(sh, &wo, &wi);
     murk_rgb f;
-    rough_eval(self, &sh, wo, wi, &f);
+    rough_eval(self, sh, wo, wi, &f);
     return f;
 }
 
-static float di_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static float di_pdf_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
-    orient(hit, &wo, &wi);
-    di_shade sh;
-    shade_at(self, hit, &sh);
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    orient(sh, &wo, &wi);
     murk_rgb f;
-    return rough_eval(self, &sh, wo, wi, &f);
+    return rough_eval(self, sh, wo, wi, &f);
 }
 
-static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+static int di_sample_oriented(const dielectric *d, const di_shade *sh, murk_vec3 wo, const float u[3],
                               murk_bsdf_sample *s);
 
-static int di_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+static int di_sample_at(const void *self, const murk_shading *sp, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
 {
-    int in = orient(hit, &wo, NULL);
-    int ok = di_sample_oriented(self, hit, wo, u, s);
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    int in = orient(sh, &wo, NULL);
+    int ok = di_sample_oriented(self, sh, wo, u, s);
     if (in)
         s->wi.z = -s->wi.z;
     return ok;
 }
 
-static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+MURK_MATERIAL_HIT_METHODS(di)
+
+static int di_sample_oriented(const dielectric *d, const di_shade *sh, murk_vec3 wo, const float u[3],
                               murk_bsdf_sample *s)
 {
     memset(s, 0, sizeof *s);
     s->eta = 1.0f;
     if (!usable(wo.z))
         return 0;
-    di_shade sh;
-    shade_at(d, hit, &sh);
     float uc = u[2];
     int ch = 0;
     if (d->dispersive) { /* one channel's lobes, chosen uniformly; uc reused for the lobe choice */
@@ -407,7 +415,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
         uc = uc * 3.0f - (float)ch;
     }
     float eta = d->eta[ch];
-    if (!(sh.alpha > 0.0f)) { /* smooth: two delta lobes */
+    if (!(sh->alpha > 0.0f)) { /* smooth: two delta lobes */
         float R = murk_fresnel_dielectric(wo.z, eta), T = 1.0f - R;
         float w;
         if (uc < R) {
@@ -421,7 +429,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
                 return 0;
             s->pdf = T;
             w = T;
-            s->f = murk_rgb_scale(sh.tint, T / (etap * etap * fabsf(s->wi.z)));
+            s->f = murk_rgb_scale(sh->tint, T / (etap * etap * fabsf(s->wi.z)));
             s->eta = etap;
         }
         if (!(w > 0.0f))
@@ -437,7 +445,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     int lobe_ms = 0;
     if (d->ms) { /* the compensation lobe with probability 1 - E(mu_o) (see ms_prepare) */
         ms_at m;
-        ms_prepare(&d->tab[ch], sh.alpha, eta, wo.z < 0.0f, fabsf(wo.z), &m);
+        ms_prepare(&d->tab[ch], sh->alpha, eta, wo.z < 0.0f, fabsf(wo.z), &m);
         if (uc < m.one_eo) {
             lobe_ms = 1;
             float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1], z = sqrtf(murk_maxf(0.0f, 1.0f - u[0]));
@@ -451,7 +459,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     }
     if (!lobe_ms) { /* a visible normal of wo (of -wo when wo is inside), then Fresnel's choice */
         murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
-        murk_vec3 wm = murk_ggx_sample_vndf(wv, sh.alpha, u[0], u[1]);
+        murk_vec3 wm = murk_ggx_sample_vndf(wv, sh->alpha, u[0], u[1]);
         float R = murk_fresnel_dielectric(murk_dot(wo, wm), eta);
         if (uc < R) {
             wi = murk_reflect(wo, wm);
@@ -467,7 +475,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     if (!usable(wi.z))
         return 0;
     murk_rgb f;
-    float pdf = rough_eval(d, &sh, wo, wi, &f);
+    float pdf = rough_eval(d, sh, wo, wi, &f);
     if (!(pdf > 0.0f) || !isfinite(pdf) || !murk_rgb_finite(f))
         return 0;
     s->wi = wi;
@@ -478,6 +486,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
 
 static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, di_create, di_destroy, di_eval, di_pdf, di_sample,
+    di_prepare, di_eval_at, di_pdf_at, di_sample_at,
 };
 
 MURK_MATERIAL_PLUGIN("dielectric",

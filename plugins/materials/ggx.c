@@ -340,35 +340,35 @@ static void ggx_destroy(void *self)
         g->host->free(g);
 }
 
-static murk_rgb ggx_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static void ggx_prepare(const void *self, const murk_hit *hit, murk_shading *sp)
 {
-    if (!above(wo.z) || !above(wi.z))
-        return murk_rgb1(0.0f);
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    return ggx_eval_sh(&sh, wo, wi);
+    _Static_assert(sizeof(ggx_shade) <= MURK_SHADING_BYTES, "ggx_shade fits a murk_shading");
+    ggx_shade_at(self, hit, (ggx_shade *)sp->data.bytes);
 }
 
-static float ggx_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static murk_rgb ggx_eval_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
-    if (!above(wo.z) || !above(wi.z))
-        return 0.0f;
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    return ggx_pdf_sh(&sh, wo, wi);
+    (void)self;
+    return ggx_eval_sh((const ggx_shade *)sp->data.bytes, wo, wi);
 }
 
-static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+static float ggx_pdf_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
+    (void)self;
+    return ggx_pdf_sh((const ggx_shade *)sp->data.bytes, wo, wi);
+}
+
+static int ggx_sample_at(const void *self, const murk_shading *sp, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+{
+    (void)self;
+    const ggx_shade *sh = (const ggx_shade *)sp->data.bytes;
     memset(s, 0, sizeof *s);
     if (!above(wo.z))
         return 0;
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    float ps = ggx_pspec_at(&sh, fminf(wo.z, 1.0f));
+    float ps = ggx_pspec_at(sh, fminf(wo.z, 1.0f));
     murk_vec3 wi;
     if (u[2] < ps) {
-        murk_vec3 h = murk_ggx_sample_vndf(wo, sh.alpha, u[0], u[1]);
+        murk_vec3 h = murk_ggx_sample_vndf(wo, sh->alpha, u[0], u[1]);
         if (!(murk_dot(wo, h) > 0.0f))
             return 0;
         wi = murk_reflect(wo, h);
@@ -378,8 +378,8 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
     }
     if (!above(wi.z))
         return 0;
-    float pdf = ggx_pdf_sh(&sh, wo, wi);
-    murk_rgb f = ggx_eval_sh(&sh, wo, wi);
+    float pdf = ggx_pdf_sh(sh, wo, wi);
+    murk_rgb f = ggx_eval_sh(sh, wo, wi);
     if (!(pdf > 0.0f) || !isfinite(pdf) || !murk_rgb_finite(f))
         return 0;
     s->wi = wi;
@@ -389,8 +389,11 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
     return 1;
 }
 
+MURK_MATERIAL_HIT_METHODS(ggx)
+
 static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, ggx_create, ggx_destroy, ggx_eval, ggx_pdf, ggx_sample,
+    ggx_prepare, ggx_eval_at, ggx_pdf_at, ggx_sample_at,
 };
 
 MURK_MATERIAL_PLUGIN("ggx", "Lambertian base under a GGX specular coat (energy-conserving, reciprocal)", params,
