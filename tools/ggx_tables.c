@@ -1,7 +1,7 @@
 /* ggx_tables.c — generates the tables of two material plugins; a tool of the repository, not of the
  * plugins (tools/meson.build checks that its output equals the committed headers):
- *     ninja -C build tools/ggx_tables && ./build/tools/ggx_tables > plugins/materials/ggx_tables.h   (~10 s)
- *     ./build/tools/ggx_tables dielectric > plugins/materials/dielectric_tables.h                 (~30 s)
+ *     ninja -C build tools/ggx_tables && ./build/tools/ggx_tables > plugins/materials/ggx_tables.h
+ *     ./build/tools/ggx_tables dielectric > plugins/materials/dielectric_tables.h
  * The GGX and Fresnel formulas it shares with the plugins come from murk/microfacet.h (in double).
  *
  * ggx_tables.h: M(mu, alpha), the directional albedo term of ggx's energy-conserving diffuse base, with

@@ -1,59 +1,10 @@
-/* dielectric — a smooth or rough (GGX) dielectric interface: glass, water, a liquid's surface. Reflects
- * and transmits (murk/material.h, "Transmission"): it reads which side wo is on from the hit
- * (murk_material_wo_inside: the hit's n, flipped to wo's side by the integrator, against the shape's
- * ng) and works below in its own oriented frame, +z = outside, where wo.z < 0 means wo inside.
- *
- * Parameters
- *   ior        RGB in [1, 4], default 1.5. Index of refraction of the inside (the -ng side: inside a
- *              sphere or box, behind a quad's u x v) relative to the outside. One number for grey; three
- *              different numbers give RGB dispersion: each channel refracts with its own index (a
- *              sample then follows one channel, chosen uniformly, and carries 3x that channel's weight
- *              and 0 in the others; with roughness the pdf is the average of the channels' pdfs).
- *   roughness  float in [0, 1], default 0. 0: a smooth interface, two delta lobes (mirror reflection and
- *              Snell refraction) that eval()/pdf() do not describe and sample() marks delta = 1, so the
- *              integrators skip light sampling and MIS for it. > 0: GGX microfacet reflection and
- *              transmission (Walter et al. 2007) with alpha = roughness^2 (clamped to >= 0.001),
- *              height-correlated Smith masking-shadowing, visible-normal sampling (Dupuy & Benyoub 2023).
- *   tint       RGB in [0, 1], default 1. Multiplies transmitted light at each crossing (a thin coloured
- *              film; the colour of a thick body belongs in a medium: `interior:`).
- *   multiscatter  bool, default true. Rough only: multiple-scattering energy compensation (below), so that
- *              a rough interface without absorption loses no light; false gives the single-scattering
- *              model exactly as before it existed (for A/B: at roughness 1 it keeps 0.31 of the energy
- *              arriving from inside an ior 2.4 body at normal incidence, and a rough ior 1.5 sphere in a
- *              white furnace renders 0.36 instead of 1).
- *
- * Model (pbrt-v4's DielectricBxDF, in murk's oriented frame: +z = the shading normal = outside; wo.z < 0
- * is wo inside). eta = ior per channel; etap = eta_wi / eta_wo (eta when wo is outside and wi inside,
- * 1 / eta the other way). Fresnel is the exact unpolarised dielectric formula, total internal
- * reflection included (F = 1 past the critical angle, from inside).
- *   smooth  R = F(|wo.z|), T = 1 - R; sample() picks reflection with probability R, else refraction;
- *           f = R / |wi.z| (reflection) and T tint / (etap^2 |wi.z|) (refraction), pdf = R or T, so
- *           the path weight is exactly 1 (reflection) or tint / etap^2.
- *   rough   with wm the generalised half vector (wo + etap wi, facing +z):
- *           reflection   f = D(wm) G2(wo, wi) F(wo.wm) / (4 |wo.z| |wi.z|)
- *           transmission f = D(wm) G2(wo, wi) (1 - F) tint |wi.wm| |wo.wm| / (|wi.z| |wo.z| (wi.wm + wo.wm / etap)^2) / etap^2
- *           sampling: a visible normal of wo (the lobe of -wo when wo is inside), then reflection with
- *           probability F(wo.wm), else refraction through wm; pdf = D_wo(wm) R / (4 |wo.wm|) or
- *           D_wo(wm) T |wi.wm| / (wi.wm + wo.wm / etap)^2, D_wo(wm) = G1(wo) D(wm) |wo.wm| / |wo.z|.
- *           Microfacets facing away from wo or wi are discarded (f = pdf = 0); samples that reflect
- *           through the surface or refract back to wo's side are rejected (sample() returns 0).
- * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, their dielectric extension):
- *           the single-scattering model's energy albedo E_s(mu) (reflection + transmission, the latter as
- *           energy: radiance x etap^2; s = the side wo is on) falls short of 1 because microfacets shadow
- *           and mask each other; a compensation lobe adds exactly the missing 1 - E_s(mu_o), split between
- *           reflection and transmission so that both sides conserve energy and transmission stays
- *           reciprocal (derivation at ms_prepare). E is tabulated per side over (mu, alpha, eta) by
- *           tools/ggx_tables.c (dielectric_tables.h; its axes in dielectric_tables_axis.h); create()
- *           blends the two nearest eta nodes' rows for its ior and averages them exactly. The lobe is
- *           sampled with probability 1 - E_s(mu_o), cosine-weighted on the chosen side; pdf() is the
- *           mixture. With dispersion every channel has its own tables.
- * Transport mode: radiance. murk's integrators trace from the camera and carry radiance, so a
- * transmitted f includes (eta_wo / eta_wi)^2 — radiance is compressed into the denser medium. The
- * reciprocity that holds is eval(wo, wi) / eta_wo^2 = eval(wi, wo) / eta_wi^2. sample() reports
- * s->eta = etap for a refracted sample (1 for a reflected one). With ior 1 and roughness 0 the surface
- * is invisible (F = 0, straight through).
- *
- * Robustness: |wo.z| or |wi.z| below 1e-9 gives f = 0, pdf = 0 and no sample; every output is finite. */
+/* dielectric — a smooth or rough dielectric interface (glass, water, a liquid's surface) that reflects
+ * and transmits (murk/material.h, "Transmission"): exact Fresnel, smooth delta lobes or GGX microfacet
+ * reflection and transmission (Walter et al. 2007; pbrt-v4's DielectricBxDF) with height-correlated
+ * Smith masking-shadowing (Heitz 2014) and visible-normal sampling (Heitz 2018; Dupuy & Benyoub 2023),
+ * multiple-scattering compensation (Kulla & Conty 2017) and RGB dispersion. It works in its own
+ * oriented frame, +z = outside, where wo.z < 0 means wo inside. The model is derived in
+ * docs/materials.md; the tables come from tools/ggx_tables.c. */
 #include "murk/material.h"
 #include "murk/microfacet.h"
 
@@ -172,23 +123,12 @@ static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
     return murk_clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
 }
 
-/* The lobe (Kulla & Conty 2017's dielectric extension). Sides: o outside (index 1), i inside (index
- * eta); E_o, E_i the single-scattering energy albedos seen from each side (tables), A_s = 1 - Eavg_s their
- * averages' shortfalls, Favg = integral of F(mu, eta) 2 mu dmu from outside. For wo on side s, wi on s':
- *   reflection    f = r_s (1 - E_s(mu_o)) (1 - E_s(mu_i)) / (pi A_s)
- *   transmission  f = t_s eta_s^2 / (eta_s'^2 pi A_s') (1 - E_s(mu_o)) (1 - E_s'(mu_i)),  t_s = 1 - r_s.
- * Energy: the reflection lobe returns r_s (1 - E_s(mu_o)), the transmission lobe (its radiance albedo
- * times (eta_s' / eta_s)^2) t_s (1 - E_s(mu_o)): together exactly the single-scattering model's loss, so
- * the compensated albedo is E_s + 1 - E_s = 1 for any split. Reciprocity, f(a, b) / eta_a^2 =
- * f(b, a) / eta_b^2 (murk/material.h): reflection is symmetric; transmission needs
- * t_o / (eta^2 A_i) = t_i / A_o, i.e. t_o A_o = eta^2 t_i A_i — the transmitted compensation energy
- * crossing each way balances, as Fresnel's own 1 - Favg(1 / eta) = (1 - Favg(eta)) / eta^2 does for a
- * smooth interface. Kulla & Conty's split satisfies it with one fraction x shared by both sides:
- *   t_o = (1 - Favg) x,  t_i = (1 - Favg) (1 - x) / eta^2,  x = A_i / (A_o + A_i),
- * which is in [0, 1 - Favg] and [0, (1 - Favg) / eta^2]: both sides' shares are valid. Then
- *   transmission f = kt (1 - E_s(mu_o)) (1 - E_s'(mu_i)) / eta^2 from outside, kt (...) from inside,
- *        kt = (1 - Favg) / (pi (A_o + A_i)): f(o, i) / 1 = f(i, o) / eta^2 (reciprocal),
- *   reflection   f = kr (1 - E_s(mu_o)) (1 - E_s(mu_i)), kr = r_s / (pi A_s), r_o = 1 - t_o, r_i = 1 - t_i.
+/* The lobe (Kulla & Conty 2017's dielectric extension; derived in docs/materials.md). Sides: o outside,
+ * i inside (index eta); A_s = 1 - Eavg_s, Favg the outside's Fresnel average. For wo on side s, wi on s':
+ *   transmitted share  t_o = (1 - Favg) A_i / (A_o + A_i),  t_i = (1 - Favg) A_o / (eta^2 (A_o + A_i)),
+ *                      r_s = 1 - t_s (both sides conserve energy; transmission stays reciprocal)
+ *   reflection    f = kr (1 - E_s(mu_o)) (1 - E_s(mu_i)),  kr = r_s / (pi A_s)
+ *   transmission  f = kt (1 - E_s(mu_o)) (1 - E_s'(mu_i)) [/ eta^2 from outside],  kt = (1 - Favg) / (pi (A_o + A_i))
  * It is sampled with probability 1 - E_s(mu_o) (the energy it carries), then reflection with
  * probability r_s, else transmission, the direction cosine-weighted on that side. */
 static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float mu_o, ms_at *m)
@@ -297,7 +237,7 @@ static float rough_eval(const dielectric *d, const di_shade *sh, murk_vec3 wo, m
 
 /* The compensation's tables for index eta (in [1, 4]): the rows of the two nearest eta nodes blended on
  * the aligned axis (dielectric_tables_axis.h), their exact averages, and Favg by a midpoint rule in mu^2
- * (F is smooth from outside; 4096 points: error < 1e-7). */
+ * with 4096 points (F is smooth from outside; its error: docs/results.md). */
 static void ms_build(di_ms *t, double eta)
 {
     double x = sqrt(fmax(0.0, (eta - 1.0) / 3.0)) * (DI_TAB_NETA - 1);

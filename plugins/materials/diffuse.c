@@ -1,11 +1,6 @@
-/* diffuse — Lambertian reflection.
- *
- * Parameters
- *   albedo  RGB in [0,1], default 0.5, texturable. Fraction of light reflected; f = albedo / pi.
- *
- * Reflection only, on whichever side wo lies (the integrator flips the frame). Sampling is
- * cosine-weighted over the hemisphere, so f cos / pdf = albedo exactly. Emission is a property of the
- * shape (`emission:` in the scene), not of the material. */
+/* diffuse — Lambertian reflection, f = albedo / pi, on whichever side wo lies (the integrator flips the
+ * frame), sampled cosine-weighted (Malley's method), so f cos / pdf = albedo exactly. Emission is a
+ * property of the shape (`emission:` in the scene), not of the material. */
 #include "murk/material.h"
 
 #include <string.h>

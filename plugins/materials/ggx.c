@@ -1,76 +1,9 @@
-/* ggx — a Lambertian base under a GGX microfacet specular coat (reflection only).
- *
- * Parameters
- *   albedo     RGB in [0,1], default 0.5, texturable. Reflectance of the diffuse base: with specular 0
- *              the material is exactly Lambertian with f = albedo / pi.
- *   specular   RGB in [0,1], default 0.04, texturable. F0, the normal-incidence reflectance of the coat
- *              in Schlick's Fresnel F(c) = F0 + (1 - F0)(1 - c)^5 (0.04 ~ plastics and glass, 1 = a
- *              perfect mirror coat: no light reaches the base).
- *   roughness  float in [0,1], default 0.5, texturable. Perceptual roughness; the GGX width is
- *              alpha = roughness^2.
- *   alpha      float in [0,1], optional, texturable. The GGX width itself; when the scene gives it, it
- *              overrides roughness (alpha = value, not squared). Giving both is allowed: alpha wins and
- *              create() logs a warning.
- *   The effective alpha is clamped to [0.001, 1]: roughness 0 (or alpha 0) is a very sharp but finite
- *   GGX lobe, never a delta lobe, so eval/pdf/sample stay one smooth, MIS-able distribution.
- *   multiscatter  bool, default true. Multiple-scattering compensation of the coat (below); false gives
- *              the single-scattering model exactly as before it existed (for A/B: it loses up to 69 % of
- *              the light at roughness 1).
- *
- * Model (local shading frame, n = +z, mu = cos theta):
- *   f = f_spec + f_diff
- *   f_spec(wo,wi) = F(wo.h) D(h) V(mu_o, mu_i),  h = normalize(wo + wi)
- *     D  GGX / Trowbridge-Reitz NDF (Walter et al. 2007): alpha^2 / (pi (alpha^2 h.z^2 + h.x^2 + h.y^2)^2)
- *     V  height-correlated Smith (Heitz 2014) G2 / (4 mu_o mu_i) = 0.5 / (mu_i R(mu_o) + mu_o R(mu_i)),
- *        R(mu) = sqrt(mu^2 (1 - alpha^2) + alpha^2)
- *   f_diff(wo,wi) = albedo (1 - F0) / pi * (1 - M(mu_o)) (1 - M(mu_i)) / (1 - Mavg)
- *
- * Energy conservation (the weighting of the diffuse lobe). Let
- *   E_F(wo) = integral over visible microfacet normals of F(wo.h) D_wo(h) dh = F0 + (1 - F0) M(mu_o),
- *   M(mu) = integral of (1 - wo.h)^5 D_wo(h) dh,   D_wo = G1(wo) max(0, wo.h) D(h) / mu_o (the VNDF),
- * the fraction of the light arriving from wo that the coat's microfacets reflect (Fresnel-weighted).
- * Because the height-correlated G2 <= G1(wo), the specular lobe's directional albedo
- * E_spec(wo) = integral of f_spec cos <= E_F(wo). The diffuse lobe above is a Kelemen & Szirmay-Kalos
- * (2001) style separable, symmetric (hence reciprocal) lobe whose normalisation
- * Mavg = integral of M(mu) 2 mu dmu makes its directional albedo exactly albedo (1 - E_F(wo)). So
- *   E(wo) = E_spec(wo) + albedo (1 - E_F(wo)) <= E_F(wo) + 1 - E_F(wo) = 1
- * for every albedo, specular and roughness; with albedo 1 the only loss is the coat's
- * single-scattering shortfall E_F - E_spec (no multiple-scattering compensation). f is symmetric in
- * (wo, wi) term by term, so reciprocal. M has no closed form: it is tabulated below over
- * (t = sqrt(mu), r = sqrt(alpha)) and read bilinearly; every table entry carries a local safety margin
- * so that the interpolated M is never below the true M (checked densely by the generator), which keeps
- * the bound E <= 1 rigorous. Mavg is integrated exactly from that same interpolant. The tables are
- * in ggx_tables.h, written by tools/ggx_tables.c (see there to regenerate them).
- *
- * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, chosen over Turquin 2019
- * because its extra lobe is symmetric in (wo, wi), so the BSDF stays reciprocal, and is sampled exactly by
- * the cosine lobe the base already uses; Turquin's 1 + F0 (1 - E(mu_o)) / E(mu_o) scale of f_spec is not
- * reciprocal). With E(mu) the coat's single-scattering albedo for F = 1 and Eavg its cosine average,
- *   f_ms(wo,wi) = Fms (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Eavg)),
- *   Fms = Favg^2 Eavg / (1 - Favg (1 - Eavg)),  Favg = F0 + (1 - F0) / 21 (Schlick's average),
- * whose albedo is Fms (1 - E(mu_o)): with F0 = 1 the coat reflects E + 1 - E = 1 (the furnace). The base
- * then sits under the coat's energy bound X instead of E_F:
- *   X(mu) = F0 E(mu) + (1 - F0) M(mu) + Fms (1 - E(mu)),   f_diff = albedo (1 - X(mu_o)) (1 - X(mu_i)) / (pi (1 - Xavg)),
- * because the single-scattering albedo with Schlick's Fresnel is F0 E + (1 - F0) E5 (E5: F = (1 - c)^5)
- * and E5 <= M. So E(wo) <= X(wo) + albedo (1 - X(wo)) <= 1 again, and every term is symmetric. E is
- * tabulated (ggx_e, with safety margins so that the table is never below E: the bound stays rigorous,
- * and the compensated furnace is 1 minus at most that margin, 0.23 %) on the axis
- * w = mu (1 + alpha) / (mu + alpha), which resolves E's dip near mu ~ alpha at low alpha; Eavg
- * (ggx_eavg) is the exact average of that interpolant at 8 points per table row, interpolated between
- * (error 2.4e-6). P_spec weighs the coat's single scattering F0 E + (1 - F0) M against the compensation
- * lobe and the base together (both cosine-sampled).
- *
- * Sampling: with probability P_spec the coat (visible-normal sampling of GGX with the spherical-cap
- * method of Dupuy & Benyoub 2023, then mirror reflection), otherwise the base (cosine-weighted
- * hemisphere). P_spec = lum(E_F(wo)) / (lum(E_F(wo)) + lum(albedo (1 - E_F(wo)))), the lobes'
- * expected contributions, clamped to [0.05, 0.95] when both lobes are non-zero (exactly 1 when the base
- * is black, 0 when the coat is). pdf() is the exact mixture P_spec pdf_spec + (1 - P_spec) pdf_diff with
- * pdf_spec = D(h) G1(wo) / (4 mu_o); coat samples that reflect below the horizon are rejected (sample()
- * returns 0), so pdf() integrates to 1 minus that rejected mass.
- *
- * Robustness: wo.z or wi.z below 1e-9 (the horizon, below it, NaN) gives f = 0 and pdf = 0; sample()
- * returns 0 there and for rejected or zero-pdf samples. No formula divides by mu or tan theta alone, so
- * grazing directions (wo.z = 1e-7) stay finite, and with alpha >= 0.001 every output is bounded. */
+/* ggx — a Lambertian base under a GGX microfacet specular coat, reflection only: GGX (Walter et al.
+ * 2007) with height-correlated Smith masking-shadowing (Heitz 2014), visible-normal sampling (Heitz
+ * 2018, spherical caps: Dupuy & Benyoub 2023) and Schlick's Fresnel; an energy-conserving, reciprocal
+ * diffuse base under the coat (Kelemen & Szirmay-Kalos 2001) and multiple-scattering compensation
+ * (Kulla & Conty 2017). The model, its energy bound and its sampling are derived in docs/materials.md;
+ * the tables come from tools/ggx_tables.c. */
 #include "murk/material.h"
 #include "murk/microfacet.h"
 
