@@ -37,7 +37,7 @@ static const char usage_text[] =
     "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
     "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
     "  murk plugins [NAME]\n"
-    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]] [--html PAGE.html]\n"
     "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
@@ -78,6 +78,7 @@ static const struct command_help {
      "defaults and ranges (for a tracker also the keys every medium has).\n"},
     {"compare",
      "usage: murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+     "                    [--html PAGE.html]\n"
      "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) with its standard error, the mean absolute relative error,\n"
      "a bias test (mean of a-b with its standard error and z-score) and, from the EXRs' render times and cost\n"
      "counters, the efficiency 1/(relMSE x seconds) and 1/(relMSE x density lookups).\n"
@@ -85,7 +86,9 @@ static const struct command_help {
      "  --json           one JSON object instead of text\n"
      "  --diff D.png     a heat map of |a-b| (white = the 99th percentile) and D_signed.png, the signed relative\n"
      "                   difference (a-b)/(|b|+0.01) on a fixed scale: blue -S, white 0, red +S\n"
-     "  --scale S        that scale (default 1)\n"},
+     "  --scale S        that scale (default 1)\n"
+     "  --html P.html    the interactive comparison page: both images (flip, split, zoom, exposure), the error\n"
+     "                   and efficiency maps and these figures, in one self-contained file\n"},
     {"bench", NULL}, /* bench.c prints its own (murk bench --help) */
     {"merge",
      "usage: murk merge OUT.exr PART.exr...\n"
