@@ -360,14 +360,22 @@ static void base64(FILE *f, const unsigned char *d, size_t n)
     }
 }
 
-/* {"exp": E, "b64": "..."}: the halves little endian, in chunks so that no buffer holds them all. */
-static void json_halves(FILE *f, const half_array *a)
+/* {"exp": E, "id": ID}: the array's scale and the id of the element holding its halves (half_element). */
+static void json_halves(FILE *f, const half_array *a, int id)
 {
-    if (!a->v) {
+    if (a->v)
+        fprintf(f, "{\"exp\": %d, \"id\": \"murk-half-%d\"}", a->exp, id);
+    else
         fputs("null", f);
+}
+
+/* The halves as base64 of their little-endian bytes in an element of their own, outside the JSON (the
+ * page decodes them natively, with no JSON string to parse), in chunks so that no buffer holds them all. */
+static void half_element(FILE *f, const half_array *a, int id)
+{
+    if (!a->v)
         return;
-    }
-    fprintf(f, "{\"exp\": %d, \"b64\": \"", a->exp);
+    fprintf(f, "<script type=\"text/plain\" id=\"murk-half-%d\">", id);
     unsigned char buf[3 * 4096];
     for (size_t i = 0; i < a->n;) {
         size_t m = 0;
@@ -377,7 +385,7 @@ static void json_halves(FILE *f, const half_array *a)
         }
         base64(f, buf, m); /* m is a multiple of 3 except at the end */
     }
-    fputs("\"}", f);
+    fputs("</script>\n", f);
 }
 
 static void json_data(FILE *f, const murk_html_page *p)
@@ -402,9 +410,9 @@ static void json_data(FILE *f, const murk_html_page *p)
         fputs(", \"relmse\": ", f);
         json_num(f, im->relmse);
         fputs(",\n \"rgb\": ", f);
-        json_halves(f, &im->rgb);
+        json_halves(f, &im->rgb, 2 * i);
         fputs(",\n \"err\": ", f);
-        json_halves(f, &im->err);
+        json_halves(f, &im->err, 2 * i + 1);
         fputc('}', f);
     }
     fputs("],\n\"text\": {", f);
@@ -432,7 +440,7 @@ static void json_data(FILE *f, const murk_html_page *p)
     fputs("]}", f);
 }
 
-/* The template with its @@CSS@@, @@JS@@ and @@DATA@@ replaced. */
+/* The template with its @@CSS@@, @@JS@@, @@DATA@@ and @@HALVES@@ replaced. */
 static int page_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
 {
     const murk_html_page *p = user;
@@ -449,6 +457,12 @@ static int page_fill(FILE *f, const char *tmp, void *user, char *err, size_t err
         } else if (!strncmp(at, "@@DATA@@", 8)) {
             json_data(f, p);
             t = at + 8;
+        } else if (!strncmp(at, "@@HALVES@@", 10)) {
+            for (int i = 0; i < p->nimages; i++) {
+                half_element(f, &p->img[i].rgb, 2 * i);
+                half_element(f, &p->img[i].err, 2 * i + 1);
+            }
+            t = at + 10;
         } else {
             snprintf(err, errlen, "the page's template has an unknown placeholder");
             return -1;

@@ -1,7 +1,7 @@
 /* report_page.js — the comparison page's behaviour (`murk compare --html`, `murk bench`'s report.html).
  *
  * The data (the JSON in #murk-data, written by core/cli/report_html.c): every image as linear half floats
- * (IEEE binary16, little endian, base64) times 2^exp, and for the variants their per-pixel error maps (the
+ * (IEEE binary16, little endian, base64, in the element named by its id) times 2^exp, and for the variants their per-pixel error maps (the
  * channel mean of the relative squared error against the reference; for a bench the mean over its seeds).
  * Tone mapping is murk's PNG preview's: x = linear * 2^EV, clamped to [0, 1], sRGB transfer curve, 8 bits
  * (round half up), computed from the half floats themselves, so any exposure is exact. NaN is magenta and
@@ -39,8 +39,15 @@
     const e = (h >> 10) & 31, m = h & 1023, s = h & 0x8000 ? -1 : 1;
     HALF[h] = e === 31 ? (m ? NaN : s * Infinity) : e ? s * (1024 + m) * 2 ** (e - 25) : s * m * 2 ** -24;
   }
-  function decode(a) {
-    const bin = atob(a.b64), n = bin.length >> 1, u = new Uint16Array(n);
+  const LITTLE = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
+  function decode(a) { /* the halves of element a.id: base64 of little-endian bytes */
+    const e = document.getElementById(a.id), text = e.textContent;
+    e.remove(); /* its text is not needed again */
+    if (Uint8Array.fromBase64 && LITTLE) {
+      const b = Uint8Array.fromBase64(text);
+      return new Uint16Array(b.buffer, 0, b.length >> 1);
+    }
+    const bin = atob(text), n = bin.length >> 1, u = new Uint16Array(n);
     for (let i = 0, j = 0; i < n; i++, j += 2) u[i] = bin.charCodeAt(j) | (bin.charCodeAt(j + 1) << 8);
     return u;
   }
@@ -315,7 +322,8 @@
     S.zoom = z;
   }
   function resize() {
-    const cssW = $('stage').clientWidth, cssH = Math.round(Math.max(240, Math.min(window.innerHeight * 0.72, cssW * H / W)));
+    /* the image as wide as the page, but short enough that the controls, legend and readout stay in view */
+    const cssW = $('stage').clientWidth, cssH = Math.round(Math.max(240, Math.min(window.innerHeight * 0.62, cssW * H / W)));
     canvas.style.height = cssH + 'px';
     canvas.width = Math.round(cssW * dpr());
     canvas.height = Math.round(cssH * dpr());
