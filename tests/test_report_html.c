@@ -307,7 +307,8 @@ static void compare_bad_input(void **state)
     free(out);
 
     /* a path murk cannot write: refused before the images are read (they do not even exist here) */
-    assert_int_equal(run_murk(&out, "compare", "missing1.exr", "missing2.exr", "--html", "/no/such/dir/p.html", NULL), 1);
+    assert_int_equal(run_murk(&out, "compare", "missing1.exr", "missing2.exr", "--html", "/no/such/dir/p.html", NULL),
+                     1);
     assert_contains(out, "/no/such/dir/p.html: its folder /no/such/dir does not exist");
     assert_not_contains(out, "missing1.exr");
     free(out);

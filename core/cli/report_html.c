@@ -96,9 +96,11 @@ void murk_html_downsample(const float *src, int w, int h, int ch, int k, float *
         memset(sum, 0, (size_t)ow * (size_t)ch * sizeof *sum);
         int y1 = (oy + 1) * k < h ? (oy + 1) * k : h;
         for (int y = oy * k; y < y1; y++)
-            for (int x = 0; x < w; x++)
+            for (int x = 0; x < w; x++) {
+                const float *px = src + ((size_t)y * (size_t)w + (size_t)x) * (size_t)ch;
                 for (int c = 0; c < ch; c++)
-                    sum[(size_t)(x / k) * (size_t)ch + (size_t)c] += src[((size_t)y * (size_t)w + (size_t)x) * (size_t)ch + (size_t)c];
+                    sum[(size_t)(x / k) * (size_t)ch + (size_t)c] += px[c];
+            }
         for (int ox = 0; ox < ow; ox++) {
             int x1 = (ox + 1) * k < w ? (ox + 1) * k : w;
             double n = (double)(x1 - ox * k) * (double)(y1 - oy * k);

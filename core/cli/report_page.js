@@ -1,8 +1,9 @@
 /* report_page.js — the comparison page's behaviour (`murk compare --html`, `murk bench`'s report.html).
  *
  * The data (the JSON in #murk-data, written by core/cli/report_html.c): every image as linear half floats
- * (IEEE binary16, little endian, base64, in the element named by its id) times 2^exp, and for the variants their per-pixel error maps (the
- * channel mean of the relative squared error against the reference; for a bench the mean over its seeds).
+ * (IEEE binary16, little endian, base64, in the element named by its id) times 2^exp, and for the variants
+ * their per-pixel error maps (the channel mean of the relative squared error against the reference; for a
+ * bench the mean over its seeds).
  * Tone mapping is murk's PNG preview's: x = linear * 2^EV, clamped to [0, 1], sRGB transfer curve, 8 bits
  * (round half up), computed from the half floats themselves, so any exposure is exact. NaN is magenta and
  * an infinity cyan, in every view; the readout names them.
@@ -129,8 +130,9 @@
         'scale 10^\u22123 (black) to 10^1 (yellow). NaN magenta, \u00b1Inf cyan.' },
     signed: { ramp: BWR, log: false,
       ticks: () => [[0, '\u2212' + S.signed], [0.5, '0'], [1, '+' + S.signed]],
-      text: () => 'signed difference (a \u2212 r) / (|r| + 0.01), mean of R, G, B; fixed scale: blue \u2212' + S.signed +
-        ', white 0, red +' + S.signed + ' (murk compare --diff --scale ' + S.signed + '). NaN magenta, \u00b1Inf cyan.' },
+      text: () => 'signed difference (a \u2212 r) / (|r| + 0.01), mean of R, G, B; fixed scale: blue \u2212' +
+        S.signed + ', white 0, red +' + S.signed + ' (murk compare --diff --scale ' + S.signed + '). NaN magenta, ' +
+        '\u00b1Inf cyan.' },
     efficiency: { ramp: PRGN, lo: -1, hi: 1, log: true,
       ticks: [[0, '0.1\u00d7'], [0.25, '0.32\u00d7'], [0.5, '1\u00d7'], [0.75, '3.2\u00d7'], [1, '10\u00d7']],
       text: () => 'efficiency per pixel, 1 / (e \u00b7 ' + costName() + '), relative to the first variant\u2019s ' +
@@ -183,7 +185,8 @@
         }
       for (let y = 0; y < H; y++)
         for (let x = 0; x < W; x++) {
-          const x0 = Math.max(x - R, 0), x1 = Math.min(x + R + 1, W), y0 = Math.max(y - R, 0), y1 = Math.min(y + R + 1, H);
+          const x0 = Math.max(x - R, 0), x1 = Math.min(x + R + 1, W);
+          const y0 = Math.max(y - R, 0), y1 = Math.min(y + R + 1, H);
           const s = I[y1 * (W + 1) + x1] - I[y0 * (W + 1) + x1] - I[y1 * (W + 1) + x0] + I[y0 * (W + 1) + x0];
           m[y * W + x] = s / ((x1 - x0) * (y1 - y0));
         }
@@ -252,7 +255,8 @@
   }
   function paint(im, d) {
     if (S.mode === 'image') return paintImage(im, d);
-    if (S.mode === 'relerr' || S.mode === 'signed') return paintValues(diffMap(im, S.mode === 'signed'), MODES[S.mode], d);
+    if (S.mode === 'relerr' || S.mode === 'signed')
+      return paintValues(diffMap(im, S.mode === 'signed'), MODES[S.mode], d);
     if (S.mode === 'efficiency') {
       if (!im.err) { for (let q = 0; q < 4 * NPIX; q += 4) put(d, q, NONE_RGB); return; }
       return paintValues(effMap(im), MODES.efficiency, d);
@@ -323,7 +327,8 @@
   }
   function resize() {
     /* the image as wide as the page, but short enough that the controls, legend and readout stay in view */
-    const cssW = $('stage').clientWidth, cssH = Math.round(Math.max(240, Math.min(window.innerHeight * 0.62, cssW * H / W)));
+    const cssW = $('stage').clientWidth;
+    const cssH = Math.round(Math.max(240, Math.min(window.innerHeight * 0.62, cssW * H / W)));
     canvas.style.height = cssH + 'px';
     canvas.width = Math.round(cssW * dpr());
     canvas.height = Math.round(cssH * dpr());
@@ -348,10 +353,11 @@
   }
   function legend() {
     const bar = $('legend-bar'), ticks = $('legend-ticks'), text = $('legend-text');
+    const tick = ([t, s]) => ticks.append(el('span', { text: s, style: 'left:' + 100 * t + '%' }));
     ticks.textContent = '';
     if (S.mode === 'image') {
       bar.style.background = 'linear-gradient(to right, #000, #fff)';
-      [[0, '0'], [1, fv(2 ** -S.ev) + ' and above']].forEach(([t, s]) => ticks.append(el('span', { text: s, style: 'left:' + 100 * t + '%' })));
+      [[0, '0'], [1, fv(2 ** -S.ev) + ' and above']].forEach(tick);
       text.textContent = 'linear \u00d7 2^' + S.ev.toFixed(1) + ', clamped to [0, 1], sRGB (as murk\u2019s PNG ' +
         'preview); NaN magenta, \u00b1Inf cyan.';
       return;
@@ -370,7 +376,7 @@
     const m = MODES[S.mode], stops = [];
     for (let i = 0; i <= 8; i++) stops.push('rgb(' + m.ramp(i / 8).join(',') + ') ' + (100 * i / 8) + '%');
     bar.style.background = 'linear-gradient(to right, ' + stops.join(', ') + ')';
-    (typeof m.ticks === 'function' ? m.ticks() : m.ticks).forEach(([t, s]) => ticks.append(el('span', { text: s, style: 'left:' + 100 * t + '%' })));
+    (typeof m.ticks === 'function' ? m.ticks() : m.ticks).forEach(tick);
     text.textContent = m.text();
   }
   function select(i) {
@@ -454,7 +460,8 @@
     $('cost').addEventListener('change', (e) => { S.cost = e.target.value; update(); });
     $('fit').addEventListener('click', () => { fit(); update(); });
     $('one').addEventListener('click', () => { oneToOne(); update(); });
-    $('stage').append(el('div', { id: 'split-labels', hidden: '' }, el('span', { id: 'split-left' }), el('span', { id: 'split-right' })));
+    $('stage').append(el('div', { id: 'split-labels', hidden: '' }, el('span', { id: 'split-left' }),
+      el('span', { id: 'split-right' })));
   }
   function oneToOne() {
     const cx = canvas.width / 2, cy = canvas.height / 2;
@@ -465,7 +472,8 @@
     const pos = (e) => [e.offsetX * dpr(), e.offsetY * dpr()];
     canvas.addEventListener('mousedown', (e) => {
       const [cx, cy] = pos(e);
-      drag = S.split && Math.abs(cx - dividerX()) <= 6 * dpr() ? { divider: true } : { x: cx, y: cy, ox: S.ox, oy: S.oy };
+      const onDivider = S.split && Math.abs(cx - dividerX()) <= 6 * dpr();
+      drag = onDivider ? { divider: true } : { x: cx, y: cy, ox: S.ox, oy: S.oy };
       canvas.focus();
       e.preventDefault();
     });
@@ -519,13 +527,16 @@
         D.source[1] + ' \u2192 ' + W + '\u00d7' + H + '; each pixel the mean of ' + D.factor + '\u00d7' + D.factor +
         ' pixels, maps too) to keep the page\u2019s image data within its limit of ' + mib(D.limit) +
         ' (MURK_MAX_PAGE_BYTES raises it).');
+    const count = (n, what) => n + ' ' + what + (n > 1 ? 's' : '');
     IM.forEach((im) => {
-      if (im.nan || im.inf)
-        say('\'' + im.label + '\' has ' + (im.nan ? im.nan + ' NaN pixel' + (im.nan > 1 ? 's' : '') + ' (magenta)' : '') +
-          (im.nan && im.inf ? ' and ' : '') + (im.inf ? im.inf + ' infinite pixel' + (im.inf > 1 ? 's' : '') + ' (cyan)' : '') + '.');
+      const parts = [];
+      if (im.nan) parts.push(count(im.nan, 'NaN pixel') + ' (magenta)');
+      if (im.inf) parts.push(count(im.inf, 'infinite pixel') + ' (cyan)');
+      if (parts.length) say('\'' + im.label + '\' has ' + parts.join(' and ') + '.');
     });
     if (D.missing && D.missing.length)
-      say('Charts not found in the bench folder (--no-charts, or the chart script failed): ' + D.missing.join(', ') + '.');
+      say('Charts not found in the bench folder (--no-charts, or the chart script failed): ' +
+        D.missing.join(', ') + '.');
   }
 
   /* ---- tables ---- */
@@ -575,9 +586,11 @@
     const cols = ['relmse', 'seconds', 'lookups', 'rays', 'nonfinite', 'max_sample'];
     const agg = labels.map((_, v) => Object.fromEntries(budgets.map((b) => {
       const sel = rows.filter((r) => r.variant === v && r.budget === b);
-      return [b, sel.length ? Object.fromEntries(cols.map((c) => [c, meanSe(sel.map((r) => r[c]))]).concat([['n', sel.length]])) : null];
+      if (!sel.length) return [b, null];
+      return [b, Object.fromEntries(cols.map((c) => [c, meanSe(sel.map((r) => r[c]))]).concat([['n', sel.length]]))];
     })));
-    const big = budgets[budgets.length - 1], eff = (v, b, c) => ratio(efficiency(agg[v][b], c), efficiency(agg[0][b], c));
+    const big = budgets[budgets.length - 1];
+    const eff = (v, b, c) => (v ? pm(...ratio(efficiency(agg[v][b], c), efficiency(agg[0][b], c))) : '1');
     const summary = D.text.report && /## Summary\n\n([\s\S]*?)\n\n/.exec(D.text.report);
     sec.append(el('h2', { text: 'Summary' }));
     if (summary) sec.append(el('p', { text: summary[1] }));
@@ -586,21 +599,22 @@
       'equal lookups', 'NaN/Inf', 'max sample'], labels.map((l, v) => {
       const s = agg[v][big];
       if (!s) return [l, 'no renders', '', '', '', '', '', '', ''];
-      return [l, pm(...s.relmse), pm(...s.seconds), g3(s.lookups[0]), g3(s.rays[0]), v ? pm(...eff(v, big, 'seconds')) : '1',
-        v ? pm(...eff(v, big, 'lookups')) : '1', String(Math.round(s.nonfinite[0] * s.n)), g3(s.max_sample[0])];
+      return [l, pm(...s.relmse), pm(...s.seconds), g3(s.lookups[0]), g3(s.rays[0]), eff(v, big, 'seconds'),
+        eff(v, big, 'lookups'), String(Math.round(s.nonfinite[0] * s.n)), g3(s.max_sample[0])];
     })));
     const all = [];
     budgets.forEach((b) => labels.forEach((l, v) => {
       const s = agg[v][b];
-      if (s) all.push([l, String(b), pm(...s.relmse), pm(...s.seconds), g3(s.lookups[0]), v ? pm(...eff(v, b, 'seconds')) : '1',
-        v ? pm(...eff(v, b, 'lookups')) : '1']);
+      if (s) all.push([l, String(b), pm(...s.relmse), pm(...s.seconds), g3(s.lookups[0]), eff(v, b, 'seconds'),
+        eff(v, b, 'lookups')]);
     }));
-    sec.append(el('details', {}, el('summary', { text: 'Every budget (' + budgets.length + ': ' + budgets.join(', ') + ' ' + unit +
-      '; mean \u00b1 standard error over the seeds)' }),
-    table(['variant', 'budget', 'relMSE', 'seconds', 'density lookups', 'efficiency vs first, equal time', 'equal lookups'], all)));
-    sec.append(el('p', { text: 'relMSE = mean over pixels and channels of ((a \u2212 r)\u00b2 \u2212 v) / (r\u00b2 + 0.01), the ' +
-      'reference\u2019s own noise v subtracted; efficiency = 1 / (relMSE \u00d7 cost). Each image above is the first seed\u2019s ' +
-      'render at ' + big + ' ' + unit + '; its error map (efficiency views) is the mean over all ' + (meta ? meta.repeat : '') + ' seeds.' }));
+    const every = 'Every budget (' + budgets.join(', ') + ' ' + unit + '; mean \u00b1 standard error over the seeds)';
+    sec.append(el('details', {}, el('summary', { text: every }), table(['variant', 'budget', 'relMSE', 'seconds',
+      'density lookups', 'efficiency vs first, equal time', 'equal lookups'], all)));
+    sec.append(el('p', { text: 'relMSE = mean over pixels and channels of ((a \u2212 r)\u00b2 \u2212 v) / ' +
+      '(r\u00b2 + 0.01), the reference\u2019s own noise v subtracted; efficiency = 1 / (relMSE \u00d7 cost). ' +
+      'Each image above is the first seed\u2019s render at ' + big + ' ' + unit + '; its error map (efficiency ' +
+      'views) is the mean over all ' + (meta ? meta.repeat + ' ' : '') + 'seeds.' }));
   }
   function compareTable(sec) {
     const f = JSON.parse(D.text.figures), rows = [['MSE', g3(f.mse)], ['relMSE', pm(f.relmse, f.relmse_se)],
@@ -608,7 +622,8 @@
       ['mean difference a \u2212 r', pm(f.diff[3], f.diff_se[3]) + '  (z = ' + f.z.toFixed(2) + (Math.abs(f.z) < 3 ?
         ': no sign of a different expected image)' : ': the expected images differ)')],
       ['pixel-channels compared', String(f.n)], ['NaN/Inf pixel-channels skipped', String(f.nonfinite)]];
-    if (f.efficiency_time) rows.push(['efficiency 1/(relMSE \u00d7 seconds)', g3(f.efficiency_time) + '  (' + g3(f.seconds) + ' s)']);
+    if (f.efficiency_time)
+      rows.push(['efficiency 1/(relMSE \u00d7 seconds)', g3(f.efficiency_time) + '  (' + g3(f.seconds) + ' s)']);
     if (f.efficiency_lookups) rows.push(['efficiency 1/(relMSE \u00d7 lookups)', g3(f.efficiency_lookups)]);
     sec.append(el('h2', { text: 'Figures (murk compare)' }), table(['', f.test + ' against ' + f.reference], rows));
   }
@@ -635,8 +650,9 @@
   $('title').textContent = D.title;
   const meta = D.text.bench ? JSON.parse(D.text.bench) : null;
   $('subtitle').textContent = meta ? meta.command : D.text.command || '';
-  $('footer').textContent = 'murk comparison page: ' + IM.length + ' images of ' + W + '\u00d7' + H + ' as half floats; image ' +
-    'data ' + mib(D.bytes) + ' of its ' + mib(D.limit) + ' limit (MURK_MAX_PAGE_BYTES). Nothing is loaded from outside this file.';
+  $('footer').textContent = 'murk comparison page: ' + IM.length + ' images of ' + W + '\u00d7' + H + ' as half ' +
+    'floats; image data ' + mib(D.bytes) + ' of its ' + mib(D.limit) + ' limit (MURK_MAX_PAGE_BYTES). Nothing is ' +
+    'loaded from outside this file.';
   buildControls();
   notices();
   sections();
@@ -646,6 +662,9 @@
   window.murkPage = {
     ready: true, state: S, width: W, height: H, labels: IM.map((im) => im.label),
     imageToCanvas: (x, y) => [S.ox + (x + 0.5) * S.zoom, S.oy + (y + 0.5) * S.zoom],
-    canvasToClient: (cx, cy) => { const r = canvas.getBoundingClientRect(); return [r.left + cx / dpr(), r.top + cy / dpr()]; },
+    canvasToClient: (cx, cy) => {
+      const r = canvas.getBoundingClientRect();
+      return [r.left + cx / dpr(), r.top + cy / dpr()];
+    },
   };
 })();
