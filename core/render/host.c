@@ -203,6 +203,13 @@ static const murk_medium *host_camera_medium(const murk_scene *s) { return s->ca
 
 static size_t host_boundaries(const murk_scene *s) { return s->nboundaries; }
 
+static float host_environment_pdf(const murk_scene *s, murk_vec3 dir)
+{
+    (void)s;
+    (void)dir;
+    return 0.0f; /* the constant background is not sampled */
+}
+
 static const murk_host host_table = {
     .size = sizeof(murk_host),
     .abi_major = MURK_ABI_MAJOR,
@@ -227,6 +234,7 @@ static const murk_host host_table = {
     .sample_light_with = murk_lights_sample,
     .light_pdf_with = murk_lights_pdf,
     .boundaries = host_boundaries,
+    .environment_pdf = host_environment_pdf,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }
