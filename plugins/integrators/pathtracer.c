@@ -49,7 +49,9 @@ const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
     PT_SHARED_PARAMS
     [MURK_PT_EQUIANGULAR] = {"equiangular", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
                              "also sample each medium segment equiangularly (Kulla and Fajardo 2012) towards a "
-                             "reference point on a light, and combine that vertex's NEE with the free flight's "
+                             "reference point on a light (a point or spot light's position; a reference light at "
+                             "infinity, a distant light or the environment, has no point: that segment has free "
+                             "flights alone), and combine that vertex's NEE with the free flight's "
                              "by MIS (the balance heuristic; a per-segment exponential stands in for the free "
                              "flight's pdf, exact in a grey homogeneous medium and an approximation elsewhere, "
                              "which changes the noise, never the image). Free flights are untouched. It pays off "
