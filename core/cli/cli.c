@@ -396,9 +396,11 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 2;
     }
-    if (mpi_run.rank == 0) { /* refuse before rendering: an output path naming a directory, device, FIFO or link */
+    if (mpi_run.rank == 0) { /* refuse before rendering: an output path naming a directory, device, FIFO or link,
+                                or in a folder where it cannot be written (the session checks its own outputs) */
         char oerr[1024], *png0 = png_path_for(outbuf);
-        int bad = murk_output_check(outbuf, oerr, sizeof oerr) || murk_output_check(png0, oerr, sizeof oerr);
+        int bad = murk_output_probe(outbuf, "image", oerr, sizeof oerr) ||
+                  murk_output_probe(png0, "PNG preview", oerr, sizeof oerr);
         free(png0);
         if (bad) {
             cli_error(oerr);

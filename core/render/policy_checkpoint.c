@@ -1,11 +1,13 @@
 /* policy_checkpoint.c — the session's checkpoints (session.h; the file: checkpoint.h). checkpoint
- * (--checkpoint FILE [--every S]): the state of the whole passes done is saved after a pass once
+ * (--checkpoint FILE [--every S]): whether FILE can be written is checked before the first sample (not
+ * found out after the whole render); the state of the whole passes done is saved after a pass once
  * checkpoint_every seconds have passed since the last save, and at the end — also after a stop, so the
  * render can be resumed. resume (--resume FILE): the state saved is loaded before the first pass, and the
  * render goes on from its spp. */
 #include "render/checkpoint.h"
 #include "render/session.h"
 #include "scene/scene.h"
+#include "util/atomic.h"
 #include "util/error.h"
 #include "util/util.h"
 
@@ -42,6 +44,12 @@ static int save_when_due(murk_session *ss, void *self, char *err, size_t errlen)
     return MURK_PASS_GO;
 }
 
+static int check(murk_session *ss, void *self, char *err, size_t errlen)
+{
+    (void)self;
+    return murk_output_probe(ss->opts.checkpoint, "checkpoint", err, errlen);
+}
+
 static int save_at_end(murk_session *ss, void *self, int rc, char *err, size_t errlen)
 {
     (void)self;
@@ -56,6 +64,7 @@ void murk_policy_checkpoint(murk_pass_policy *p)
     *last = -1;
     p->name = "checkpoint";
     p->self = last;
+    p->begin = check;
     p->after = save_when_due;
     p->end = save_at_end;
     p->release = free;

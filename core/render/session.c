@@ -5,6 +5,8 @@
 #include "render/mpi_job.h"
 #include "render/session.h"
 #include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/error.h"
 #include "util/runtime.h"
 #include "util/util.h"
 
@@ -60,28 +62,33 @@ static void plug_parts(murk_session *ss, int stoppable)
 /* Hidden, for bench/stability/atlas.py: MURK_SAMPLE_DUMP=FILE writes every sample's RGB as float32
  * [pixel][sample][r, g, b] (pixels row by row) after the render, for per-sample statistics (firefly
  * rate, largest sample, non-finite count). Up to 2^26 samples; not with --resume; under MPI, rank 0's
- * tiles only. */
-static void open_dump(murk_session *ss)
+ * tiles only. FILE is checked before the first sample, like every output. */
+static int open_dump(murk_session *ss, char *err, size_t errlen)
 {
     const char *path = getenv("MURK_SAMPLE_DUMP");
     size_t npix = (size_t)ss->s->width * (size_t)ss->s->height;
     if (!path || !*path || ss->opts.resume || ss->spp <= 0 || npix * (size_t)ss->spp > ((size_t)1 << 26))
-        return;
+        return 0;
+    if (murk_output_probe(path, "sample dump (MURK_SAMPLE_DUMP)", err, errlen) != 0)
+        return -1;
     ss->job.dump = calloc(3 * npix * (size_t)ss->spp, sizeof(float));
     ss->job.dump_spp = ss->spp;
     ss->dump_path = path;
+    return 0;
+}
+
+static int fill_dump(FILE *fp, const char *tmp, void *user, char *err, size_t errlen)
+{
+    const murk_job *j = user;
+    size_t n = 3 * (size_t)j->s->width * (size_t)j->s->height * (size_t)j->dump_spp;
+    return fwrite(j->dump, sizeof(float), n, fp) == n ? 0 : murk_err_file(err, errlen, tmp, "cannot write");
 }
 
 static void write_dump(murk_session *ss)
 {
-    size_t n = 3 * (size_t)ss->s->width * (size_t)ss->s->height * (size_t)ss->job.dump_spp;
-    if (!ss->job.dump)
-        return;
-    FILE *f = fopen(ss->dump_path, "wb");
-    if (!f || fwrite(ss->job.dump, sizeof(float), n, f) != n)
-        fprintf(stderr, "murk: MURK_SAMPLE_DUMP: cannot write %s\n", ss->dump_path);
-    if (f)
-        fclose(f);
+    char err[1024];
+    if (ss->job.dump && murk_write_atomic(ss->dump_path, fill_dump, &ss->job, err, sizeof err) != 0)
+        fprintf(stderr, "murk: MURK_SAMPLE_DUMP: %s\n", err);
 }
 
 static void close_session(murk_session *ss)
@@ -127,8 +134,7 @@ murk_session *murk_session_open(const murk_scene *s, const murk_render_opts *opt
     if (opts->progress)
         ss->progress = murk_progress_bar;
     plug_parts(ss, stoppable);
-    open_dump(ss);
-    int rc = 0;
+    int rc = open_dump(ss, ss->msg, sizeof ss->msg);
     for (int i = 0; i < ss->nparts && rc == 0; i++)
         if (ss->parts[i].begin)
             rc = ss->parts[i].begin(ss, ss->parts[i].self, ss->msg, sizeof ss->msg);

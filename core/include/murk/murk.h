@@ -58,9 +58,9 @@ murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t ns
 void murk_scene_free(murk_scene *scene);
 /* Renders the scene: murk_session_begin, murk_session_run_pass until it returns 0 or -1, murk_session_end
  * (below); in passes only when opts asks for them (time_limit, stop, checkpoint), else in one. 0, or -1
- * with a one-line message in err (a checkpoint that cannot be read, is of another scene, or cannot be
- * written); err may be NULL. On -1 out->rgb is NULL when nothing was rendered, else the image of the whole
- * passes done. */
+ * with a one-line message in err (an output that cannot be written, found before the first sample; a
+ * checkpoint that cannot be read, is of another scene, or cannot be saved); err may be NULL. On -1
+ * out->rgb is NULL when nothing was rendered, else the image of the whole passes done. */
 int murk_render(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out);
 int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_render_result *out, char *err,
                     size_t errlen);
@@ -73,10 +73,11 @@ int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_
  *       ;                                        between passes: look at Ctrl-C, update a display
  *   int rc = murk_session_end(ss, &result, err, sizeof err);                frees ss; free(result.rgb)
  *
- * begin reads opts->resume before the first sample. Passes take about half a second each (or fill
- * opts->time_limit), so a stop loses at most one. The image depends on the scene, seed and spp only,
- * however the render was cut into passes, stopped and resumed. Under MPI every rank calls the same
- * functions; rank 0 decides the passes, takes the stops and alone gets the image.
+ * Before the first sample, begin checks that every file the session will write can be written
+ * (opts->checkpoint; MURK_SAMPLE_DUMP's file) and reads opts->resume. Passes take about half a second
+ * each (or fill opts->time_limit), so a stop loses at most one. The image depends on the scene, seed and
+ * spp only, however the render was cut into passes, stopped and resumed. Under MPI every rank calls the
+ * same functions; rank 0 decides the passes, takes the stops and alone gets the image.
  * libmurk keeps per-thread counters in initial-exec TLS (fast, but from glibc's small static reserve): a
  * process that dlopen()s libmurk after it started (ctypes.CDLL) must be started with
  * GLIBC_TUNABLES=glibc.rtld.optional_static_tls=8192 (or LD_PRELOAD=libmurk.so), else dlopen fails with
@@ -87,8 +88,9 @@ typedef struct murk_session murk_session;
  * murk_session_run_pass, about five times a second during a pass. */
 typedef void (*murk_progress_fn)(void *user, double fraction, double seconds, int last);
 
-/* NULL, with a one-line message in err, when the scene cannot be rendered as opts asks: a checkpoint to
- * resume that cannot be read or is not this render's. opts is copied; its strings (checkpoint, resume,
+/* NULL, with a one-line message in err, when the scene cannot be rendered as opts asks: an output that
+ * cannot be written (nothing is rendered, nothing written), a checkpoint to resume that cannot be read or
+ * is not this render's. opts is copied; its strings (checkpoint, resume,
  * overrides) must outlive ss. */
 murk_session *murk_session_begin(const murk_scene *scene, const murk_render_opts *opts, char *err, size_t errlen);
 /* Replaces the progress report (opts->progress's bar on stderr, or none) with fn (NULL: none). */
