@@ -267,8 +267,9 @@ MURK_API int murk_session_end(murk_session *ss, murk_render_result *out, char *e
         out->interrupted = ss->interrupted;
         out->threads = ss->threads;
     } else {
+        /* short of spp after a stop, or ended before run_pass said it was over (not --time's end) */
+        ss->interrupted = ss->done < ss->spp && (murk_job_stopped(&ss->job) || !ss->over);
         ss->over = 1;
-        ss->interrupted = ss->done < ss->spp && murk_job_stopped(&ss->job);
         if (ss->progress) {
             int total = ss->spp - ss->start;
             ss->progress(ss->progress_user, (double)(ss->done - ss->start) / (total > 0 ? total : 1),

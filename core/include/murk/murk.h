@@ -37,7 +37,8 @@ typedef struct murk_render_result {
                                other than 0: rank 0 gets the image) */
     double seconds;
     uint64_t samples, rays, nonfinite; /* samples and rays: this run's; nonfinite: the image's (resumed too) */
-    int interrupted;        /* opts->stop was set (or murk_session_stop called) before spp was reached */
+    int interrupted;        /* opts->stop was set before spp was reached (or murk_session_stop called, or the
+                               session ended early: murk_session_end) */
     int resumed_spp;        /* spp taken from opts->resume */
     /* This run's cost counters per medium, in the scene's order (murk/counters.h): nmedia blocks, the
      * last one shared when the scene has more than MURK_COUNTER_SLOTS media. */
@@ -99,12 +100,13 @@ void murk_session_set_progress(murk_session *ss, murk_progress_fn fn, void *user
  * stop taken; this call rendered the last pass or none); -1: it failed (err says why: a checkpoint that
  * could not be saved). Then murk_session_end. */
 int murk_session_run_pass(murk_session *ss, char *err, size_t errlen);
-/* Asks the session to stop, from any thread (a progress callback too), as setting *opts->stop does: the
- * running pass is abandoned and does not count; the next murk_session_run_pass returns 0. */
+/* Asks the session to stop, from any thread (a progress callback too) until murk_session_end, as setting
+ * *opts->stop does: the running pass is abandoned and does not count; the next run_pass returns 0. */
 void murk_session_stop(murk_session *ss);
 /* Ends the session and frees ss: saves the final checkpoint (opts->checkpoint) and fills out as
- * murk_render_err does (out->rgb: the image of the whole passes done; free() it). 0, or -1 with err set
- * (the session failed, or the final checkpoint could not be saved). */
+ * murk_render_err does (out->rgb: the image of the whole passes done; free() it). Ended short of spp after
+ * a stop, or before run_pass returned 0, out->interrupted is 1. 0, or -1 with err set (the session
+ * failed, or the final checkpoint could not be saved). */
 int murk_session_end(murk_session *ss, murk_render_result *out, char *err, size_t errlen);
 
 /* --part I/N: the 16x16 tile (numbered row-major) that holds pixel (x, y) of a w x h image belongs to
