@@ -1,7 +1,8 @@
 #!/bin/sh
 # test_sdk.sh — the plugin author's path of docs/plugins.md, end to end, against an INSTALLED murk:
 #   1. `meson install --destdir` this build into a fresh temporary folder;
-#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0) and, with no
+#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0 and
+#      libmurklab.so.0, the lab, whose code libmurk does not hold) and, with no
 #      MURK_PLUGIN_PATH, finds and renders with its built-in plugins (the murk/plugins folder beside
 #      the installed libmurk, though the install is staged away from its prefix);
 #   3. copy the installed share/murk/examples, build them out of tree with their own meson.build and
@@ -35,6 +36,15 @@ BUILTINS=$(dirname "$BUILTINS")
 step "the installed murk finds libmurk through its RPATH"
 readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
 env -u LD_LIBRARY_PATH "$MURK" --version || fail "installed murk does not start (RPATH?)"
+
+step "the lab is libmurklab, apart from libmurk"
+LIBMURK=$(find "$TMP/root" -name libmurk.so.0 | head -n 1)
+LIBLAB=$(find "$TMP/root" -name libmurklab.so.0 | head -n 1)
+[ -n "$LIBMURK" ] && [ -n "$LIBLAB" ] || fail "libmurk.so.0 or libmurklab.so.0 not installed"
+[ -n "$(find "$TMP/root" -path '*/include/murk/lab.h')" ] || fail "murk/lab.h not installed"
+nm -D --defined-only "$LIBLAB" | grep -q ' murk_lab_check$' || fail "libmurklab does not export murk_lab_check"
+nm -D --defined-only "$LIBMURK" | grep -E ' murk_(lab|check|chi2|sph)_' && fail "libmurk holds the lab's code"
+readelf -d "$MURK" | grep -q 'libmurklab' || fail "the installed murk does not link libmurklab"
 
 step "the installed murk finds its built-in plugins beside its libmurk (no MURK_PLUGIN_PATH)"
 # the install is staged under a destdir, not at its configured prefix: only a search relative to the

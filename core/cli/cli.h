@@ -15,9 +15,7 @@ int murk_cli_info(int argc, char **argv);
  * medium and material is used (murk_scene_check_unused). NULL after printing the one-line error. */
 struct murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets);
 
-int murk_cli_compare(int argc, char **argv); /* compare.c */
 int murk_cli_plugins(int argc, char **argv); /* plugins.c */
-int murk_cli_bench(int argc, char **argv);   /* bench.c */
 
 /* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */
 int murk_cli_merge(int argc, char **argv);

@@ -2,12 +2,13 @@
  * the error figures of one image against a reference (metrics.c, the same code `murk bench` uses), a
  * bias test (mean difference, its standard error and z-score), the efficiency from the render time and
  * cost counters the EXR records, and two pictures of the difference: a heat map of |a - r| scaled to its
- * 99th percentile, and beside it a signed map on a fixed scale. Part of the murk executable. */
-#include "cli/cli.h"
-#include "cli/metrics.h"
+ * 99th percentile, and beside it a signed map on a fixed scale. Part of libmurklab (murk/lab.h). */
+#include "cmd/cmd.h"
 #include "image/image.h"
+#include "lab/metrics.h"
 #include "util/atomic.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <errno.h>
 #include <math.h>
@@ -129,7 +130,7 @@ static int write_maps(const char *diff, const float *A, const float *B, int w, m
     return rc;
 }
 
-int murk_cli_compare(int argc, char **argv)
+MURK_API int murk_lab_compare(int argc, char **argv)
 {
     const char *a = NULL, *b = NULL, *diff = NULL;
     int json = 0, cropped = 0;

@@ -2,10 +2,10 @@
  * every budget (--spp or --time) with --repeat seeds, measures each render against a reference
  * (metrics.c: the noise-corrected relMSE and the rest) and its work (the cost counters), writes
  * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
- * the charts and report.md. Part of the murk executable. */
-#include "cli/cli.h"
-#include "cli/metrics.h"
+ * the charts and report.md. Part of libmurklab (murk/lab.h). */
+#include "cmd/cmd.h"
 #include "image/image.h"
+#include "lab/metrics.h"
 #include "load/load.h"
 #include "media/media.h"
 #include "render/counters.h"
@@ -13,6 +13,7 @@
 #include "util/atomic.h"
 #include "util/runtime.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <errno.h>
 #include <math.h>
@@ -1122,7 +1123,7 @@ static const char bench_usage[] =
     "SIGINT/SIGTERM/SIGHUP abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
     "(never bench.csv) and murk exits with 128 + the signal.\n";
 
-int murk_cli_bench(int argc, char **argv)
+MURK_API int murk_lab_bench(int argc, char **argv)
 {
     bench b = {0};
     b.repeat = 3;
