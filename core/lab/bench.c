@@ -22,17 +22,9 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 static const char *const counter_names[MURK_NCOUNTERS] = MURK_COUNTER_NAMES;
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- murk bench ---------------------------------------------------------------------------- */
 
@@ -842,7 +834,7 @@ static int run_bench(const bench *b, int argc, char **argv)
         fprintf(csv, ",%s", counter_names[k]);
     fprintf(csv, ",mse,relmse,relmse_se,relmse_raw,ref_noise,mare,nonfinite,max_sample\n");
     int big = 0;
-    double total_w = 0, done_w = 0, t0 = now();
+    double total_w = 0, done_w = 0, t0 = murk_now();
     for (int i = 0; i < b->nbudgets; i++) {
         if (b->budgets[i] > b->budgets[big])
             big = i;
@@ -862,7 +854,7 @@ static int run_bench(const bench *b, int argc, char **argv)
                 char label[1024], eta[32] = "?";
                 variant_label(b, v, label, sizeof label);
                 if (done_w > 0)
-                    fmt_eta((now() - t0) / done_w * (total_w - done_w), eta, sizeof eta);
+                    fmt_eta((murk_now() - t0) / done_w * (total_w - done_w), eta, sizeof eta);
                 count++;
                 if (tty) {
                     fprintf(stderr, "\r\033[K[%d/%d] %s  %s %g  seed %d  ETA %s", count, total, label,
@@ -966,7 +958,7 @@ static int run_bench(const bench *b, int argc, char **argv)
     ref_free(&r);
     if (rc == 0)
         printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", total, b->nvariants,
-               b->nbudgets, b->repeat, now() - t0, b->out);
+               b->nbudgets, b->repeat, murk_now() - t0, b->out);
     if (rc == 0)
         rc = run_charts(b); /* and a signal after the last render is said there */
     return rc;
