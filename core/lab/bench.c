@@ -5,7 +5,6 @@
  * the charts and report.md. Part of libmurklab (murk/lab.h). */
 #include "cmd/cmd.h"
 #include "image/image.h"
-#include "lab/metrics.h"
 #include "load/load.h"
 #include "media/media.h"
 #include "render/counters.h"

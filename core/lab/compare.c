@@ -5,7 +5,6 @@
  * 99th percentile, and beside it a signed map on a fixed scale. Part of libmurklab (murk/lab.h). */
 #include "cmd/cmd.h"
 #include "image/image.h"
-#include "lab/metrics.h"
 #include "util/atomic.h"
 #include "util/util.h"
 #include "murk/lab.h"
