@@ -6,6 +6,9 @@
 #define MURK_LAB_H
 
 #include <stddef.h>
+#include <stdint.h>
+
+#include "murk/plugin.h"
 
 /* The commands, as the murk command runs them: argv holds the arguments after the command's name
  * (argv[0] is the first argument, not "bench"), the return value is the command's exit status, and
@@ -37,5 +40,29 @@ typedef struct murk_metrics {
  * c.w x c.h floats: each pixel's channel-mean of the corrected relative squared error. */
 void murk_metrics_compute(const float *a, const float *r, const float *v, int w, murk_crop c, murk_metrics *m,
                           float *pix);
+
+/* ---- Plugins' schemas as data: what `murk plugins NAME` prints ---- */
+
+typedef struct murk_lab_plugin murk_lab_plugin; /* an open plugin; its info lives until it is closed */
+
+typedef struct murk_lab_plugin_info {
+    const char *name, *description;
+    const char *version;     /* the plugin's own version, NULL if it has none */
+    const char *path;        /* the file it was loaded from */
+    int kind;                /* murk_kind */
+    murk_abi abi;            /* the ABI it was built for */
+    const murk_param *params; /* its parameters, in schema order (murk/plugin.h) */
+    uint32_t nparams;
+} murk_lab_plugin_info;
+
+/* Finds NAME.so on the plugin search path ($MURK_PLUGIN_PATH, then the build's or the installed plugin
+ * folder) and opens it as a scene would: ABI and descriptor checked. NULL with a one-line message in err
+ * (naming the file and the cause) if it is missing or refused. */
+murk_lab_plugin *murk_lab_plugin_open(const char *name, murk_lab_plugin_info *info, char *err, size_t errlen);
+void murk_lab_plugin_close(murk_lab_plugin *plugin); /* NULL is fine */
+/* The keys every medium takes besides its tracker's parameters (sigma_a, sigma_s, ...; *n of them), in
+ * the order `murk plugins TRACKER` lists them. Two more are not of a schema's types: `density` (a map)
+ * and `transmittance` (an estimator's name, or a map with its `type`). */
+const murk_param *murk_lab_medium_params(uint32_t *n);
 
 #endif
