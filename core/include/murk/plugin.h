@@ -26,7 +26,8 @@
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
  * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h);
- * 1.6 appends murk_host.boundaries.
+ * 1.6 appends murk_host.boundaries; 1.7 appends the material's prepare() and prepared eval/pdf/sample
+ * (textures read once per vertex, murk/material.h).
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -58,7 +59,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 6
+#define MURK_ABI_MINOR 7
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
