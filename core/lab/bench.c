@@ -790,155 +790,223 @@ static int write_page(murk_html_page *page, const bench *b, int rc)
     return rc;
 }
 
-static int run_bench(const bench *b, int argc, char **argv)
+/* One row of bench.csv: a whole render, its work and its figures against the reference. */
+typedef struct bench_row {
+    int variant;            /* the variant's index (the last --vary varies fastest) */
+    const char *label;      /* "type=delta majorant_factor=4" (variant_label) */
+    double budget;          /* spp, or seconds with --time */
+    int seed;               /* 1 .. --repeat */
+    int spp;                /* rendered */
+    double seconds;         /* the render's time */
+    uint64_t rays;
+    murk_counters counters; /* summed over the media */
+    murk_metrics metrics;   /* against the reference (its noise subtracted when known) */
+    uint64_t nonfinite;     /* the render's non-finite samples plus the pixel-channels the metrics skipped */
+    double max_sample;      /* the render's largest finite sample */
+} bench_row;
+
+static void csv_row(FILE *csv, const bench_row *w)
 {
-    char err[2048], path[8192];
-    murk_scene *s0 = load_with(b, b->sets, b->nsets, err, sizeof err);
-    if (!s0) {
-        fprintf(stderr, "%s\n", err);
-        return 1;
-    }
-    reference r = {.w = s0->width, .h = s0->height};
-    murk_scene_free(s0);
+    const murk_metrics *m = &w->metrics;
+    fprintf(csv, "%d,", w->variant);
+    csv_str(csv, w->label);
+    fprintf(csv, ",%g,%d,%d,%.6f,%llu", w->budget, w->seed, w->spp, w->seconds, (unsigned long long)w->rays);
+    for (int c = 0; c < MURK_NCOUNTERS; c++)
+        fprintf(csv, ",%llu", (unsigned long long)murk_counters_get(&w->counters, c));
+    fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m->mse, m->relmse, m->relmse_se, m->relmse_raw,
+            m->ref_noise, m->mare, (unsigned long long)w->nonfinite, w->max_sample);
+}
+
+/* One bench run: the reference, then what the sweep fills render by render and the end writes out. */
+typedef struct run {
+    const bench *b;
+    reference r;
+    FILE *csv;            /* bench.csv's text in memory (rows), written whole at the end */
+    char *rows;
+    size_t rows_len;
+    murk_html_page *page; /* report.html */
+    float *pix;           /* one render's per-pixel relMSE (murk_metrics_compute) */
+    double *maps;         /* per variant: the mean of pix over the seeds at the largest budget */
+    size_t np;
+    int big;              /* the largest budget's index */
+    int done, total;      /* whole renders recorded, and asked for */
+    double t0;
+} run;
+
+/* The reference: given (--reference), or rendered or taken from the cache (make_reference); said on
+ * stdout. 0, 1 after a message, or the stop status when a signal came while rendering it. */
+static int load_reference(const bench *b, reference *r)
+{
     if (b->reference) {
-        if (read_exr(b->reference, r.w, r.h, &r.rgb) != 0) {
+        if (read_exr(b->reference, r->w, r->h, &r->rgb) != 0) {
             fprintf(stderr, "murk: --reference %s: not a readable %dx%d EXR (the scene's resolution)\n",
-                    murk_cli_q(b->reference), r.w, r.h);
+                    murk_cli_q(b->reference), r->w, r->h);
             return 1;
         }
         printf("reference: %s (given; its own noise is not known, so relMSE is not corrected for it)\n",
                murk_cli_q(b->reference));
-    } else {
-        if (make_reference(b, &r) != 0) {
-            ref_free(&r);
-            if (!stopped(b))
-                return 1;
-            fprintf(stderr, "%smurk bench: interrupted (%s) while rendering the reference; nothing written\n",
-                    murk_cli_progress() ? "\r\033[K" : "", murk_cli_stop_name());
-            return murk_cli_stop_status();
-        }
-        if (r.reused)
-            printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
-                   murk_cli_q(r.path));
-        else
-            printf("reference: %s (rendered: %d spp in %d chunks, %.1f s; cached)\n", murk_cli_q(r.path),
-                   REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS, r.seconds);
+        return 0;
     }
-    fflush(stdout);
-    char *rows = NULL;
-    size_t rows_len = 0;
-    FILE *csv = open_memstream(&rows, &rows_len); /* bench.csv, written whole at the end */
-    if (!csv) {
+    if (make_reference(b, r) != 0) {
+        if (!stopped(b))
+            return 1;
+        fprintf(stderr, "%smurk bench: interrupted (%s) while rendering the reference; nothing written\n",
+                murk_cli_progress() ? "\r\033[K" : "", murk_cli_stop_name());
+        return murk_cli_stop_status();
+    }
+    if (r->reused)
+        printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
+               murk_cli_q(r->path));
+    else
+        printf("reference: %s (rendered: %d spp in %d chunks, %.1f s; cached)\n", murk_cli_q(r->path),
+               REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS, r->seconds);
+    return 0;
+}
+
+/* bench.csv's header, the buffers of the maps, and the comparison page with the reference on it. 0, or 1
+ * after a message. */
+static int run_open(run *u)
+{
+    const bench *b = u->b;
+    char title[8192];
+    u->csv = open_memstream(&u->rows, &u->rows_len);
+    if (!u->csv) {
         fprintf(stderr, "murk: out of memory\n");
-        ref_free(&r);
         return 1;
     }
-    fprintf(csv, "variant,label,budget,seed,spp,seconds,rays");
+    fprintf(u->csv, "variant,label,budget,seed,spp,seconds,rays");
     for (int k = 0; k < MURK_NCOUNTERS; k++)
-        fprintf(csv, ",%s", counter_names[k]);
-    fprintf(csv, ",mse,relmse,relmse_se,relmse_raw,ref_noise,mare,nonfinite,max_sample\n");
-    int big = 0;
-    double total_w = 0, done_w = 0, t0 = murk_now();
-    for (int i = 0; i < b->nbudgets; i++) {
-        if (b->budgets[i] > b->budgets[big])
-            big = i;
-        total_w += b->budgets[i] * b->repeat * b->nvariants;
-    }
-    size_t np = (size_t)r.w * (size_t)r.h;
-    snprintf(path, sizeof path, "murk bench: %s", b->scene);
-    murk_html_page *page = murk_html_new("bench", path, r.w, r.h, b->nvariants + 1, b->nvariants,
-                                         murk_limit(MURK_LIMIT_PAGE_BYTES));
+        fprintf(u->csv, ",%s", counter_names[k]);
+    fprintf(u->csv, ",mse,relmse,relmse_se,relmse_raw,ref_noise,mare,nonfinite,max_sample\n");
+    u->t0 = murk_now();
+    for (int i = 0; i < b->nbudgets; i++)
+        if (b->budgets[i] > b->budgets[u->big])
+            u->big = i;
+    u->total = b->nbudgets * b->repeat * b->nvariants;
+    u->np = (size_t)u->r.w * (size_t)u->r.h;
+    snprintf(title, sizeof title, "murk bench: %s", b->scene);
+    u->page = murk_html_new("bench", title, u->r.w, u->r.h, b->nvariants + 1, b->nvariants,
+                            murk_limit(MURK_LIMIT_PAGE_BYTES));
     if (b->reference)
-        snprintf(path, sizeof path, "given: %s", b->reference);
+        snprintf(title, sizeof title, "given: %s", b->reference);
     else
-        snprintf(path, sizeof path, "%d spp, the mean of %d chunks", REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS),
-                 REF_CHUNKS);
-    murk_html_image(page, b->nvariants, "reference", path, r.rgb, 1);
-    float *pix = murk_xmalloc(np * sizeof(float));
-    double *maps = calloc(np * (size_t)b->nvariants, sizeof(double));
+        snprintf(title, sizeof title, "%d spp, the mean of %d chunks",
+                 REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS);
+    murk_html_image(u->page, b->nvariants, "reference", title, u->r.rgb, 1);
+    u->pix = murk_xmalloc(u->np * sizeof(float));
+    u->maps = calloc(u->np * (size_t)b->nvariants, sizeof(double));
+    return u->maps ? 0 : 1;
+}
+
+/* A whole render's row, and at the largest budget its share of its variant's error map and of the page
+ * (which shows the first seed's image). */
+static void record(run *u, int v, int bi, int k, const char *label, const murk_render_result *res)
+{
+    const bench *b = u->b;
+    const reference *r = &u->r;
+    bench_row w = {.variant = v, .label = label, .budget = b->budgets[bi], .seed = 1 + k, .spp = res->spp,
+                   .seconds = res->seconds, .rays = res->rays, .counters = murk_counters_total(res),
+                   .max_sample = res->max_sample};
+    murk_metrics_compute(res->rgb, r->rgb, r->var, r->w, (murk_crop){0, 0, r->w, r->h}, &w.metrics, u->pix);
+    w.nonfinite = res->nonfinite + w.metrics.nonfinite;
+    csv_row(u->csv, &w);
+    if (bi == u->big) {
+        for (size_t p = 0; p < u->np; p++)
+            u->maps[(size_t)v * u->np + p] += isfinite(u->pix[p]) ? u->pix[p] / b->repeat : 0.0;
+        murk_html_cost_add(u->page, v, res->seconds / b->repeat, (double)w.counters.lookups / b->repeat,
+                           w.metrics.relmse / b->repeat);
+        char note[96];
+        snprintf(note, sizeof note, "seed 1 of %d, %g %s", b->repeat, b->budgets[bi], b->time_mode ? "s" : "spp");
+        if (k == 0)
+            murk_html_image(u->page, v, label, note, res->rgb, 0);
+    }
+    u->done++;
+}
+
+/* Renders (or, --assemble, reads back) variant v at budget bi with seed 1 + k and records it unless a
+ * signal abandoned it. 0, or 1 after a message. */
+static int render_one(run *u, int v, int bi, int k, const char *label, const char *const *sets, size_t n)
+{
+    const bench *b = u->b;
+    murk_render_opts o = {.threads = b->threads, .stop = b->stop};
+    if (b->time_mode) {
+        o.time_limit = b->budgets[bi];
+        o.spp = 1 << 24;
+    } else {
+        o.spp = (int)b->budgets[bi];
+    }
+    murk_render_result res;
+    int failed = bench_render(b, v, bi, k, sets, n, &o, u->r.w, u->r.h, &res);
+    if (failed == 0)
+        record(u, v, bi, k, label, &res);
+    free(res.rgb);
+    return failed < 0;
+}
+
+/* Every render: budgets outermost, then seeds, variants innermost (A B A B: a drift of the machine's speed
+ * hits every variant alike), with a progress line on a terminal. 0, or 1 after a render failed; a signal
+ * stops it after the running render. */
+static int sweep(run *u)
+{
+    const bench *b = u->b;
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
     char *store[64];
     size_t nstore = 0;
-    int rc = maps ? 0 : 1, count = 0, done = 0, total = b->nbudgets * b->repeat * b->nvariants;
-    int tty = murk_cli_progress();
+    double total_w = 0, done_w = 0;
+    for (int i = 0; i < b->nbudgets; i++)
+        total_w += b->budgets[i] * b->repeat * b->nvariants;
+    int rc = 0, count = 0, tty = murk_cli_progress();
     for (int bi = 0; bi < b->nbudgets && !rc && !stopped(b); bi++)
         for (int k = 0; k < b->repeat && !rc && !stopped(b); k++)
-            for (int v = 0; v < b->nvariants && !rc && !stopped(b); v++) { /* variants innermost: A B A B */
+            for (int v = 0; v < b->nvariants && !rc && !stopped(b); v++) {
                 char label[1024], eta[32] = "?";
                 variant_label(b, v, label, sizeof label);
                 if (done_w > 0)
-                    fmt_eta((murk_now() - t0) / done_w * (total_w - done_w), eta, sizeof eta);
+                    fmt_eta((murk_now() - u->t0) / done_w * (total_w - done_w), eta, sizeof eta);
                 count++;
                 if (tty) {
-                    fprintf(stderr, "\r\033[K[%d/%d] %s  %s %g  seed %d  ETA %s", count, total, label,
+                    fprintf(stderr, "\r\033[K[%d/%d] %s  %s %g  seed %d  ETA %s", count, u->total, label,
                             b->time_mode ? "time" : "spp", b->budgets[bi], 1 + k, eta);
                     fflush(stderr);
                 }
                 size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                murk_render_opts o = {.threads = b->threads, .stop = b->stop};
-                if (b->time_mode) {
-                    o.time_limit = b->budgets[bi];
-                    o.spp = 1 << 24;
-                } else {
-                    o.spp = (int)b->budgets[bi];
-                }
-                murk_render_result res;
-                int failed = bench_render(b, v, bi, k, sets, n, &o, r.w, r.h, &res);
+                rc = render_one(u, v, bi, k, label, sets, n);
                 free_store(store, &nstore);
-                if (failed < 0) {
-                    rc = 1;
-                } else if (failed == 0) {
-                    murk_metrics m;
-                    murk_metrics_compute(res.rgb, r.rgb, r.var, r.w, (murk_crop){0, 0, r.w, r.h}, &m, pix);
-                    murk_counters t = murk_counters_total(&res);
-                    fprintf(csv, "%d,", v);
-                    csv_str(csv, label);
-                    fprintf(csv, ",%g,%d,%d,%.6f,%llu", b->budgets[bi], 1 + k, res.spp, res.seconds,
-                            (unsigned long long)res.rays);
-                    for (int c = 0; c < MURK_NCOUNTERS; c++)
-                        fprintf(csv, ",%llu", (unsigned long long)murk_counters_get(&t, c));
-                    fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m.mse, m.relmse, m.relmse_se,
-                            m.relmse_raw, m.ref_noise, m.mare, (unsigned long long)(res.nonfinite + m.nonfinite),
-                            res.max_sample);
-                    if (bi == big) {
-                        for (size_t p = 0; p < np; p++)
-                            maps[(size_t)v * np + p] += isfinite(pix[p]) ? pix[p] / b->repeat : 0.0;
-                        murk_html_cost_add(page, v, res.seconds / b->repeat, (double)t.lookups / b->repeat,
-                                           m.relmse / b->repeat);
-                        char note[96]; /* the page shows the first seed's image: one render at this budget */
-                        snprintf(note, sizeof note, "seed 1 of %d, %g %s", b->repeat, b->budgets[bi],
-                                 b->time_mode ? "s" : "spp");
-                        if (k == 0)
-                            murk_html_image(page, v, label, note, res.rgb, 0);
-                    }
-                    done++;
-                }
                 done_w += b->budgets[bi];
-                free(res.rgb);
                 murk_warn_summary();
             }
     if (tty)
         fprintf(stderr, "\r\033[K");
-    int bad = fclose(csv) != 0;
-    text_job csv_text = {rows, rows_len};
-    if (rc == 0 && (bad || !rows)) {
+    free(sets);
+    return rc;
+}
+
+/* The rows: bench.csv when every render was done; after a signal only the whole renders' rows, in
+ * bench-interrupted.csv, never as bench.csv, and the stop status. rc: the sweep's. */
+static int write_rows(run *u, int rc)
+{
+    const bench *b = u->b;
+    char err[2048], path[8192];
+    int bad = fclose(u->csv) != 0;
+    text_job csv_text = {u->rows, u->rows_len};
+    if (rc == 0 && (bad || !u->rows)) {
         fprintf(stderr, "murk: out of memory\n");
         rc = 1;
     }
-    if (rc == 0 && done < total) { /* a signal: only the whole renders' rows, never as bench.csv */
-        int cached = !b->reference && !r.reused && access(r.path, R_OK) == 0; /* rendered by this run */
+    if (rc == 0 && u->done < u->total) {
+        int cached = !b->reference && !u->r.reused && access(u->r.path, R_OK) == 0; /* rendered by this run */
         snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
-        int kept = done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) == 0;
-        if (done > 0 && !kept)
+        int kept = u->done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) == 0;
+        if (u->done > 0 && !kept)
             fprintf(stderr, "murk: %s\n", err);
         if (kept)
             fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; their rows are in %s (the columns "
                     "of bench.csv); no bench.csv, bench.json, maps or charts were written\n", murk_cli_stop_name(),
-                    done, total, murk_cli_q(path));
+                    u->done, u->total, murk_cli_q(path));
         else
             fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; nothing written%s%s%s\n",
-                    murk_cli_stop_name(), done, total, cached ? " but the reference, cached in " : "",
-                    cached ? murk_cli_q(r.path) : "", cached ? " for the next bench" : "");
+                    murk_cli_stop_name(), u->done, u->total, cached ? " but the reference, cached in " : "",
+                    cached ? murk_cli_q(u->r.path) : "", cached ? " for the next bench" : "");
         rc = murk_cli_stop_status();
     }
     snprintf(path, sizeof path, "%s/bench.csv", b->out);
@@ -950,43 +1018,78 @@ static int run_bench(const bench *b, int argc, char **argv)
         snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
         remove(path);
     }
-    free(rows);
-    /* the per-pixel maps of the largest budget, and the meta data */
+    free(u->rows);
+    return rc;
+}
+
+/* The per-pixel error maps of the largest budget (maps/variantN.npy, and on the page) and bench.json. 0,
+ * or 1 after a message. */
+static int write_maps(run *u, int argc, char **argv)
+{
+    const bench *b = u->b;
+    char err[2048], path[8192];
     snprintf(path, sizeof path, "%s/maps", b->out);
-    if (rc == 0 && mkdirs(path) != 0) {
+    if (mkdirs(path) != 0) {
         fprintf(stderr, "murk: cannot create %s: %s\n", murk_cli_q(path), strerror(errno));
-        rc = 1;
+        return 1;
     }
-    for (int v = 0; v < b->nvariants && rc == 0; v++) {
-        for (size_t p = 0; p < np; p++)
-            pix[p] = (float)maps[(size_t)v * np + p];
-        murk_html_error_map(page, v, pix);
+    for (int v = 0; v < b->nvariants; v++) {
+        for (size_t p = 0; p < u->np; p++)
+            u->pix[p] = (float)u->maps[(size_t)v * u->np + p];
+        murk_html_error_map(u->page, v, u->pix);
         snprintf(path, sizeof path, "%s/maps/variant%d.npy", b->out, v);
-        npy_job nj = {pix, r.w, r.h};
+        npy_job nj = {u->pix, u->r.w, u->r.h};
         if (murk_write_atomic(path, npy_fill, &nj, err, sizeof err) != 0) {
             fprintf(stderr, "murk: %s\n", err);
-            rc = 1;
+            return 1;
         }
     }
     snprintf(path, sizeof path, "%s/bench.json", b->out);
-    meta_job mj = {b, &r, argc, argv};
-    if (rc == 0 && murk_write_atomic(path, meta_fill, &mj, err, sizeof err) != 0) {
+    meta_job mj = {b, &u->r, argc, argv};
+    if (murk_write_atomic(path, meta_fill, &mj, err, sizeof err) != 0) {
         fprintf(stderr, "murk: %s\n", err);
-        rc = 1;
+        return 1;
     }
-    free(pix);
-    free(maps);
-    free(sets);
-    ref_free(&r);
+    return 0;
+}
+
+/* The bench once its options are checked and its folder exists: the reference, every render, the files,
+ * the charts and the page. The exit status. */
+static int run_bench(const bench *b, int argc, char **argv)
+{
+    char err[2048];
+    murk_scene *s0 = load_with(b, b->sets, b->nsets, err, sizeof err);
+    if (!s0) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    run u = {.b = b, .r = {.w = s0->width, .h = s0->height}};
+    murk_scene_free(s0);
+    int rc = load_reference(b, &u.r);
+    if (rc != 0) {
+        ref_free(&u.r);
+        return rc;
+    }
+    fflush(stdout);
+    rc = run_open(&u);
+    if (u.csv) {
+        rc = rc ? rc : sweep(&u);
+        rc = write_rows(&u, rc);
+    }
     if (rc == 0)
-        printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", total, b->nvariants,
-               b->nbudgets, b->repeat, murk_now() - t0, b->out);
+        rc = write_maps(&u, argc, argv);
+    free(u.pix);
+    free(u.maps);
+    ref_free(&u.r);
+    if (rc == 0)
+        printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", u.total, b->nvariants,
+               b->nbudgets, b->repeat, murk_now() - u.t0, b->out);
     int whole = rc == 0;
     if (rc == 0)
         rc = run_charts(b); /* and a signal after the last render is said there */
     if (whole && rc <= 1 && !stopped(b))
-        rc = write_page(page, b, rc);
-    murk_html_free(page);
+        rc = write_page(u.page, b, rc);
+    murk_html_free(u.page);
     return rc;
 }
 
@@ -1023,13 +1126,67 @@ static void emit_job(const bench *b, FILE *jobs, const char *murk, const char *s
     free(line);
 }
 
+/* jobs.txt: every render of the bench, the reference's chunks first, as one command line each that
+ * writes its image where job_out says (b->jobs: the jobs' folder, absolute). The count. */
+static int jobs_txt(const bench *b, FILE *f, const char *murk, const char *scene)
+{
+    char out[8192];
+    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    char *store[64];
+    size_t nstore = 0;
+    int njobs = 0;
+    for (int c = 0; c < REF_CHUNKS && !b->reference; c++) {
+        char seed[40];
+        size_t n = render_sets(b, -1, -1, sets, store, &nstore);
+        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
+        sets[n++] = seed;
+        job_out(b, -1, 0, c, out, sizeof out);
+        emit_job(b, f, murk, scene, sets, n, (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, out);
+        free_store(store, &nstore);
+        njobs++;
+    }
+    for (int bi = 0; bi < b->nbudgets; bi++)
+        for (int k = 0; k < b->repeat; k++)
+            for (int v = 0; v < b->nvariants; v++) {
+                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
+                job_out(b, v, bi, k, out, sizeof out);
+                emit_job(b, f, murk, scene, sets, n, b->budgets[bi], out);
+                free_store(store, &nstore);
+                njobs++;
+            }
+    free(sets);
+    return njobs;
+}
+
+/* assemble.sh: the bench's own command line, in its folder, with --assemble DIR for --emit-jobs DIR. */
+static void assemble_sh(FILE *f, const char *murk, const char *dir, int argc, char **argv)
+{
+    char cwd[4096];
+    fprintf(f, "#!/bin/sh\n# Reads the renders of jobs.txt back into bench.csv, the charts and the report: the\n"
+               "# bench's own command line, in its folder, with --assemble for --emit-jobs.\ncd");
+    shell_word(f, getcwd(cwd, sizeof cwd) ? cwd : ".");
+    fputs(" || exit 1\nexec", f);
+    shell_word(f, murk);
+    fputs(" bench", f);
+    for (int i = 0; i < argc; i++) {
+        if (!strcmp(argv[i], "--emit-jobs")) {
+            fputs(" --assemble", f);
+            shell_word(f, dir);
+            i++;
+        } else {
+            shell_word(f, argv[i]);
+        }
+    }
+    fputc('\n', f);
+}
+
 /* --emit-jobs DIR: every render of the bench (the reference's chunks first) as one line of DIR/jobs.txt,
  * DIR/slurm.sh running line SLURM_ARRAY_TASK_ID + 1 as one task of a job array, and DIR/assemble.sh,
  * this bench's command line with --assemble DIR, which reads the images back into bench.csv, the
  * charts and the report as if the renders had run here. The jobs' paths are absolute. */
 static int emit_jobs(const bench *b, int argc, char **argv)
 {
-    char murk[4096], scene[4096], dir[4096], path[8192], out[8192];
+    char murk[4096], scene[4096], dir[4096], path[8192];
     ssize_t l = readlink("/proc/self/exe", murk, sizeof murk - 1);
     if (l <= 0 || !realpath(b->scene, scene)) {
         fprintf(stderr, "murk: cannot resolve the paths of murk and %s\n", murk_cli_q(b->scene));
@@ -1048,67 +1205,25 @@ static int emit_jobs(const bench *b, int argc, char **argv)
     static const char *const names[NFILES] = {"jobs.txt", "slurm.sh", "assemble.sh"};
     char *text[NFILES] = {NULL, NULL, NULL};
     size_t len[NFILES] = {0, 0, 0};
-    FILE *f = open_memstream(&text[JOBS], &len[JOBS]);
-    if (!f) {
-        fprintf(stderr, "murk: out of memory\n");
-        return 1;
-    }
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
-    size_t nstore = 0;
-    int njobs = 0;
-    for (int c = 0; c < REF_CHUNKS && !b->reference; c++) {
-        char seed[40];
-        size_t n = render_sets(b, -1, -1, sets, store, &nstore);
-        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
-        sets[n++] = seed;
-        job_out(&jb, -1, 0, c, out, sizeof out);
-        emit_job(b, f, murk, scene, sets, n, (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, out);
-        free_store(store, &nstore);
-        njobs++;
-    }
-    for (int bi = 0; bi < b->nbudgets; bi++)
-        for (int k = 0; k < b->repeat; k++)
-            for (int v = 0; v < b->nvariants; v++) {
-                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                job_out(&jb, v, bi, k, out, sizeof out);
-                emit_job(b, f, murk, scene, sets, n, b->budgets[bi], out);
-                free_store(store, &nstore);
-                njobs++;
-            }
-    free(sets);
-    int bad = fclose(f) != 0;
-    if (!bad && (f = open_memstream(&text[SLURM], &len[SLURM])) != NULL) {
-        fprintf(f, "#!/bin/sh\n# murk bench as a Slurm job array: one render per task (line TASK + 1 of jobs.txt).\n"
-                   "#   jid=$(sbatch --parsable slurm.sh)\n"
-                   "#   sbatch --dependency=afterok:$jid --wrap 'sh %s/assemble.sh'\n"
-                   "#SBATCH --job-name=murk-bench\n#SBATCH --array=0-%d\n"
-                   "exec sh -c \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" '%s/jobs.txt')\"\n", dir, njobs - 1, dir);
-        bad = fclose(f) != 0;
-    } else {
-        bad = 1;
-    }
-    if (!bad && (f = open_memstream(&text[ASSEMBLE], &len[ASSEMBLE])) != NULL) {
-        char cwd[4096];
-        fprintf(f, "#!/bin/sh\n# Reads the renders of jobs.txt back into bench.csv, the charts and the report: the\n"
-                   "# bench's own command line, in its folder, with --assemble for --emit-jobs.\ncd");
-        shell_word(f, getcwd(cwd, sizeof cwd) ? cwd : ".");
-        fputs(" || exit 1\nexec", f);
-        shell_word(f, murk);
-        fputs(" bench", f);
-        for (int i = 0; i < argc; i++) {
-            if (!strcmp(argv[i], "--emit-jobs")) {
-                fputs(" --assemble", f);
-                shell_word(f, dir);
-                i++;
-            } else {
-                shell_word(f, argv[i]);
-            }
+    int njobs = 0, bad = 0;
+    for (int i = 0; i < NFILES && !bad; i++) {
+        FILE *f = open_memstream(&text[i], &len[i]);
+        if (!f) {
+            bad = 1;
+            break;
         }
-        fputc('\n', f);
+        if (i == JOBS)
+            njobs = jobs_txt(&jb, f, murk, scene);
+        else if (i == SLURM)
+            fprintf(f, "#!/bin/sh\n# murk bench as a Slurm job array: one render per task (line TASK + 1 of jobs.txt).\n"
+                       "#   jid=$(sbatch --parsable slurm.sh)\n"
+                       "#   sbatch --dependency=afterok:$jid --wrap 'sh %s/assemble.sh'\n"
+                       "#SBATCH --job-name=murk-bench\n#SBATCH --array=0-%d\n"
+                       "exec sh -c \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" '%s/jobs.txt')\"\n", dir, njobs - 1,
+                    dir);
+        else
+            assemble_sh(f, murk, dir, argc, argv);
         bad = fclose(f) != 0;
-    } else {
-        bad = 1;
     }
     char err[8400] = "out of memory";
     if (!bad) {
@@ -1141,160 +1256,201 @@ static const char bench_usage[] =
     "SIGINT/SIGTERM/SIGHUP abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
     "(never bench.csv) and murk exits with 128 + the signal.\n";
 
-MURK_API int murk_lab_bench(int argc, char **argv)
+/* --vary KEY=V1,V2,...: 0, or 2 after a message. */
+static int parse_vary(bench *b, const char *v)
 {
-    bench b = {0};
-    b.repeat = 3;
-    b.charts = 1;
-    b.sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.sets);
-    b.ref_sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.ref_sets);
-    b.vary = murk_xmalloc((size_t)(argc + 1) * sizeof *b.vary);
-    int rc = 0;
-    long lv;
-    for (int i = 0; i < argc && !rc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        int needs = strcmp(a, "--no-charts") && strcmp(a, "--help") && strcmp(a, "-h") && a[0] == '-';
-        if (needs && !v) {
-            fprintf(stderr, "murk: %s needs a value\n%s", murk_cli_q(a), bench_usage);
-            rc = 2;
-            break;
-        }
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(bench_usage, stdout);
-            rc = -1;
-        } else if (!strcmp(a, "--vary")) {
-            const char *eq = strchr(v, '=');
-            if (!eq || eq == v || !eq[1]) {
-                fprintf(stderr, "murk: --vary needs KEY.PATH=V1,V2,..., got '%s'\n", murk_cli_q(v));
-                rc = 2;
-            } else if (b.nvary == MAX_VARY) {
-                fprintf(stderr, "murk: at most %d --vary\n", MAX_VARY);
-                rc = 2;
-            } else {
-                vary *x = &b.vary[b.nvary++];
-                x->arg = v;
-                x->key = murk_xmalloc((size_t)(eq - v) + 1);
-                memcpy(x->key, v, (size_t)(eq - v));
-                x->key[eq - v] = 0;
-                x->vals = split_list(eq + 1, &x->nvals);
-            }
-            i++;
-        } else if (!strcmp(a, "--set")) {
-            b.sets[b.nsets++] = v, i++;
-        } else if (!strcmp(a, "--ref-set")) {
-            b.ref_sets[b.nref_sets++] = v, i++;
-        } else if (!strcmp(a, "--spp") || !strcmp(a, "--time")) {
-            rc = parse_budgets(a, v, !strcmp(a, "--time"), &b) ? 2 : 0, i++;
-        } else if (!strcmp(a, "--repeat")) {
-            char *end;
-            lv = strtol(v, &end, 10);
-            if (*end || lv < 2 || lv > 1000) {
-                fprintf(stderr, "murk: --repeat needs a whole number in [2, 1000] (standard errors need 2 seeds)\n");
-                rc = 2;
-            }
-            b.repeat = (int)lv, i++;
-        } else if (!strcmp(a, "--ref-spp") || !strcmp(a, "--threads")) {
-            char *end;
-            lv = strtol(v, &end, 10);
-            if (*end || lv < (a[2] == 'r' ? REF_CHUNKS : 0) || lv > 1L << 24) {
-                fprintf(stderr, "murk: %s needs a whole number in [%d, %ld], got '%s'\n", a, a[2] == 'r' ? REF_CHUNKS : 0,
-                        1L << 24, murk_cli_q(v));
-                rc = 2;
-            }
-            *(a[2] == 'r' ? &b.ref_spp : &b.threads) = (int)lv, i++;
-        } else if (!strcmp(a, "--reference")) {
-            b.reference = v, i++;
-        } else if (!strcmp(a, "-o")) {
-            b.out = v, i++;
-        } else if (!strcmp(a, "--emit-jobs") || !strcmp(a, "--assemble")) {
-            if (b.jobs) {
-                fprintf(stderr, "murk: --emit-jobs and --assemble are given once, not both\n%s", bench_usage);
-                rc = 2;
-            }
-            b.jobs = v, b.assemble = a[2] == 'a', i++;
-        } else if (!strcmp(a, "--no-charts")) {
-            b.charts = 0;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "murk: unknown bench option '%s'\n%s", murk_cli_q(a), bench_usage);
-            rc = 2;
-        } else if (!b.scene) {
-            b.scene = a;
-        } else {
-            fprintf(stderr, "murk: bench takes one scene\n%s", bench_usage);
-            rc = 2;
-        }
+    const char *eq = strchr(v, '=');
+    if (!eq || eq == v || !eq[1]) {
+        fprintf(stderr, "murk: --vary needs KEY.PATH=V1,V2,..., got '%s'\n", murk_cli_q(v));
+        return 2;
     }
-    if (rc == 0 && !b.scene) {
+    if (b->nvary == MAX_VARY) {
+        fprintf(stderr, "murk: at most %d --vary\n", MAX_VARY);
+        return 2;
+    }
+    vary *x = &b->vary[b->nvary++];
+    x->arg = v;
+    x->key = murk_xmalloc((size_t)(eq - v) + 1);
+    memcpy(x->key, v, (size_t)(eq - v));
+    x->key[eq - v] = 0;
+    x->vals = split_list(eq + 1, &x->nvals);
+    return 0;
+}
+
+/* --repeat, --ref-spp or --threads (a, its value v): 0, or 2 after a message. */
+static int parse_count(bench *b, const char *a, const char *v)
+{
+    char *end;
+    long lv = strtol(v, &end, 10);
+    if (!strcmp(a, "--repeat")) {
+        b->repeat = (int)lv;
+        if (*end || lv < 2 || lv > 1000) {
+            fprintf(stderr, "murk: --repeat needs a whole number in [2, 1000] (standard errors need 2 seeds)\n");
+            return 2;
+        }
+        return 0;
+    }
+    *(a[2] == 'r' ? &b->ref_spp : &b->threads) = (int)lv;
+    if (*end || lv < (a[2] == 'r' ? REF_CHUNKS : 0) || lv > 1L << 24) {
+        fprintf(stderr, "murk: %s needs a whole number in [%d, %ld], got '%s'\n", a, a[2] == 'r' ? REF_CHUNKS : 0,
+                1L << 24, murk_cli_q(v));
+        return 2;
+    }
+    return 0;
+}
+
+/* The option argv[*i] (and its value, *i moved past it) into b: 0; 2 after a message; -1 for --help,
+ * printed. */
+static int bench_option(bench *b, int argc, char **argv, int *i)
+{
+    const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
+    int needs = strcmp(a, "--no-charts") && strcmp(a, "--help") && strcmp(a, "-h") && a[0] == '-';
+    if (needs && !v) {
+        fprintf(stderr, "murk: %s needs a value\n%s", murk_cli_q(a), bench_usage);
+        return 2;
+    }
+    *i += needs;
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+        fputs(bench_usage, stdout);
+        return -1;
+    } else if (!strcmp(a, "--vary")) {
+        return parse_vary(b, v);
+    } else if (!strcmp(a, "--set")) {
+        b->sets[b->nsets++] = v;
+    } else if (!strcmp(a, "--ref-set")) {
+        b->ref_sets[b->nref_sets++] = v;
+    } else if (!strcmp(a, "--spp") || !strcmp(a, "--time")) {
+        return parse_budgets(a, v, !strcmp(a, "--time"), b) ? 2 : 0;
+    } else if (!strcmp(a, "--repeat") || !strcmp(a, "--ref-spp") || !strcmp(a, "--threads")) {
+        return parse_count(b, a, v);
+    } else if (!strcmp(a, "--reference")) {
+        b->reference = v;
+    } else if (!strcmp(a, "-o")) {
+        b->out = v;
+    } else if (!strcmp(a, "--emit-jobs") || !strcmp(a, "--assemble")) {
+        int twice = b->jobs != NULL;
+        b->jobs = v, b->assemble = a[2] == 'a';
+        if (twice) {
+            fprintf(stderr, "murk: --emit-jobs and --assemble are given once, not both\n%s", bench_usage);
+            return 2;
+        }
+    } else if (!strcmp(a, "--no-charts")) {
+        b->charts = 0;
+    } else if (a[0] == '-') {
+        fprintf(stderr, "murk: unknown bench option '%s'\n%s", murk_cli_q(a), bench_usage);
+        return 2;
+    } else if (!b->scene) {
+        b->scene = a;
+    } else {
+        fprintf(stderr, "murk: bench takes one scene\n%s", bench_usage);
+        return 2;
+    }
+    return 0;
+}
+
+/* What the options leave to check together, and the defaults: the budgets (4,16,64 spp), the variants'
+ * count, the reference's spp (16 x the largest spp budget; equal time: 1024) and the folder
+ * (bench-SCENE, in outbuf). 0, or 2 after a message. */
+static int bench_defaults(bench *b, char *outbuf, size_t outlen)
+{
+    if (!b->scene) {
         fprintf(stderr, "murk: bench needs a scene\n%s", bench_usage);
-        rc = 2;
+        return 2;
     }
-    if (rc == 0 && b.reference && (b.ref_spp || b.nref_sets)) {
+    if (b->reference && (b->ref_spp || b->nref_sets)) {
         fprintf(stderr, "murk: --reference and --ref-spp/--ref-set exclude each other\n");
-        rc = 2;
+        return 2;
     }
-    if (rc == 0 && !b.nbudgets)
-        rc = parse_budgets("--spp", "4,16,64", 0, &b);
-    b.nvariants = 1;
-    for (int j = 0; j < b.nvary && rc == 0; j++) {
-        if ((double)b.nvariants * b.vary[j].nvals > 1000) {
+    if (!b->nbudgets && parse_budgets("--spp", "4,16,64", 0, b))
+        return 2;
+    b->nvariants = 1;
+    for (int j = 0; j < b->nvary; j++) {
+        int rc = 0;
+        if ((double)b->nvariants * b->vary[j].nvals > 1000) {
             fprintf(stderr, "murk: the --vary lists make more than 1000 variants\n");
             rc = 2;
         }
-        b.nvariants *= b.vary[j].nvals;
-        for (int k = 0; k < b.vary[j].nvals; k++)
-            if (!*b.vary[j].vals[k]) {
-                fprintf(stderr, "murk: --vary %s has an empty value\n", murk_cli_q(b.vary[j].arg));
+        b->nvariants *= b->vary[j].nvals;
+        for (int k = 0; k < b->vary[j].nvals; k++)
+            if (!*b->vary[j].vals[k]) {
+                fprintf(stderr, "murk: --vary %s has an empty value\n", murk_cli_q(b->vary[j].arg));
                 rc = 2;
             }
+        if (rc)
+            return rc;
     }
-    if (rc == 0 && !b.ref_spp) { /* default: 16 x the largest spp budget (equal time: 1024) */
+    if (!b->ref_spp) {
         double mx = 0;
-        for (int i = 0; i < b.nbudgets; i++)
-            mx = fmax(mx, b.budgets[i]);
-        b.ref_spp = b.time_mode ? 1024 : (int)fmin(fmax(16 * mx, 64), 1 << 24);
+        for (int i = 0; i < b->nbudgets; i++)
+            mx = fmax(mx, b->budgets[i]);
+        b->ref_spp = b->time_mode ? 1024 : (int)fmin(fmax(16 * mx, 64), 1 << 24);
     }
-    char outbuf[4096];
-    if (rc == 0) {
-        if (!b.out) {
-            const char *base = strrchr(b.scene, '/');
-            base = base ? base + 1 : b.scene;
-            snprintf(outbuf, sizeof outbuf, "bench-%.*s", (int)strcspn(base, "."), base);
-            b.out = outbuf;
-        }
-        murk_set_quiet(1);
-        if (validate(&b) != 0)
-            rc = 1;
+    if (!b->out) {
+        const char *base = strrchr(b->scene, '/');
+        base = base ? base + 1 : b->scene;
+        snprintf(outbuf, outlen, "bench-%.*s", (int)strcspn(base, "."), base);
+        b->out = outbuf;
     }
-    if (rc == 0 && b.jobs && !b.assemble) {
-        rc = emit_jobs(&b, argc, argv);
-        rc = rc ? rc : -1;
+    return 0;
+}
+
+static void bench_free(bench *b)
+{
+    for (int j = 0; j < b->nvary; j++) {
+        free(b->vary[j].key);
+        free_list(b->vary[j].vals, b->vary[j].nvals);
+    }
+    free(b->vary);
+    free(b->sets);
+    free(b->ref_sets);
+    free(b->budgets);
+}
+
+/* The bench once its options hold: every variant loads, then --emit-jobs writes the jobs, or the folder
+ * (and the page's path) is made ready and the bench runs with the stop signals caught. The exit status,
+ * or -1 when the jobs were written. */
+static int bench_main(bench *b, int argc, char **argv)
+{
+    murk_set_quiet(1);
+    if (validate(b) != 0)
+        return 1;
+    if (b->jobs && !b->assemble) {
+        int rc = emit_jobs(b, argc, argv);
+        return rc ? rc : -1;
     }
     struct stat st;
-    int made_out = rc == 0 && stat(b.out, &st) != 0;
-    if (rc == 0)
-        b.stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
-    if (rc == 0 && mkdirs(b.out) != 0) {
-        fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b.out), strerror(errno));
-        rc = 1;
+    int made_out = stat(b->out, &st) != 0;
+    b->stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
+    if (mkdirs(b->out) != 0) {
+        fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b->out), strerror(errno));
+        return 1;
     }
     char page[4200], err[8400];
-    snprintf(page, sizeof page, "%s/report.html", b.out);
-    if (rc == 0 && murk_html_check_path(page, err, sizeof err) != 0) { /* before any render */
+    snprintf(page, sizeof page, "%s/report.html", b->out);
+    if (murk_html_check_path(page, err, sizeof err) != 0) { /* before any render */
         fprintf(stderr, "murk: %s; nothing was rendered\n", err);
-        rc = 1;
+        return 1;
     }
-    if (rc == 0) {
-        rc = run_bench(&b, argc, argv);
-        if (rc > 128 && made_out)
-            rmdir(b.out); /* interrupted: the folder it made goes again if nothing was written into it */
-    }
-    for (int j = 0; j < b.nvary; j++) {
-        free(b.vary[j].key);
-        free_list(b.vary[j].vals, b.vary[j].nvals);
-    }
-    free(b.vary);
-    free(b.sets);
-    free(b.ref_sets);
-    free(b.budgets);
+    int rc = run_bench(b, argc, argv);
+    if (rc > 128 && made_out)
+        rmdir(b->out); /* interrupted: the folder it made goes again if nothing was written into it */
+    return rc;
+}
+
+MURK_API int murk_lab_bench(int argc, char **argv)
+{
+    bench b = {.repeat = 3, .charts = 1};
+    b.sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.sets);
+    b.ref_sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.ref_sets);
+    b.vary = murk_xmalloc((size_t)(argc + 1) * sizeof *b.vary);
+    char outbuf[4096];
+    int rc = 0;
+    for (int i = 0; i < argc && !rc; i++)
+        rc = bench_option(&b, argc, argv, &i);
+    if (rc == 0)
+        rc = bench_defaults(&b, outbuf, sizeof outbuf);
+    if (rc == 0)
+        rc = bench_main(&b, argc, argv);
+    bench_free(&b);
     return rc < 0 ? 0 : rc;
 }
