@@ -3,14 +3,21 @@
  * the library exports.
  *   metrics   two small images with known differences give the figures' closed forms;
  *   schema    a material's and a tracker's descriptors as data, the keys every medium takes, and a
- *             missing plugin refused with a message naming it. */
+ *             missing plugin refused with a message naming it;
+ *   bench     murk_lab_bench_run hands over every row of bench.csv as it is written (each the same line
+ *             formatted anew), its stop flag ends the bench as SIGINT does (status 130, the whole renders'
+ *             rows in bench-interrupted.csv), and --emit-jobs is left to the command. */
+#define _XOPEN_SOURCE 700 /* nftw() */
+#include <ftw.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <cmocka.h>
 
 #include "murk/lab.h"
@@ -98,11 +105,113 @@ static void schema_as_data(void **state)
     murk_lab_plugin_close(NULL);
 }
 
+static const char scene[] =
+    "murk: 1\n"
+    "render: { resolution: [8, 8], spp: 4, seed: 0 }\n"
+    "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 40 }\n"
+    "integrator: { type: volpath_nee, max_depth: 16 }\n"
+    "background: [0.2, 0.2, 0.2]\n"
+    "materials: { white: { type: diffuse, albedo: 0.7 } }\n"
+    "media:\n"
+    "  smoke: { type: delta, density: { constant: 1 }, sigma_s: 2, sigma_a: 0.2 }\n"
+    "shapes:\n"
+    "  - { type: box, min: [-1, -1, -1], max: [1, 1, 1], interior: smoke }\n"
+    "  - { type: quad, center: [0, 2.5, 0], u: [0.5, 0, 0], v: [0, 0, 0.5], material: white, emission: 8 }\n";
+
+enum { MAX_ROWS = 16 };
+typedef struct rows_seen {
+    int n, stop_after;
+    char line[MAX_ROWS][1024]; /* each row as a line of bench.csv */
+    volatile sig_atomic_t *stop;
+} rows_seen;
+
+/* The row as bench.csv's line (its columns: README.md's "murk bench"). */
+static void on_row(void *user, const murk_bench_row *w)
+{
+    rows_seen *seen = user;
+    assert_true(seen->n < MAX_ROWS);
+    const murk_metrics *m = &w->metrics;
+    const murk_counters *c = &w->counters;
+    snprintf(seen->line[seen->n], sizeof seen->line[0],
+             "%d,\"%s\",%g,%d,%d,%.6f,%llu,%llu,%llu,%llu,%llu,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g",
+             w->variant, w->label, w->budget, w->seed, w->spp, w->seconds, (unsigned long long)w->rays,
+             (unsigned long long)c->lookups, (unsigned long long)c->cells, (unsigned long long)c->collisions,
+             (unsigned long long)c->scatters, (unsigned long long)c->shadow, m->mse, m->relmse, m->relmse_se,
+             m->relmse_raw, m->ref_noise, m->mare, (unsigned long long)w->nonfinite, w->max_sample);
+    if (++seen->n == seen->stop_after)
+        *seen->stop = 1;
+}
+
+/* The lines of DIR/NAME after its header, compared with the rows seen; their count. */
+static int same_lines(const char *dir, const char *name, const rows_seen *seen)
+{
+    char path[1024], line[2048];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        fail_msg("no %s", path);
+    int n = -1;
+    while (fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\n")] = 0;
+        if (n >= 0 && (n >= seen->n || strcmp(line, seen->line[n]) != 0))
+            fail_msg("%s line %d:\n  %s\nthe row handed over:\n  %s", path, n + 2, line, n < seen->n ? seen->line[n] : "(none)");
+        n++;
+    }
+    fclose(f);
+    return n;
+}
+
+static int remove_one(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st, (void)flag, (void)ftw;
+    return remove(path);
+}
+
+static void bench_rows(void **state)
+{
+    (void)state;
+    const char *tmp = getenv("TMPDIR");
+    char dir[1024], path[1100], out[1100], out2[1100], cache[1100];
+    snprintf(dir, sizeof dir, "%s/murk-test-lab-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    assert_non_null(mkdtemp(dir));
+    snprintf(cache, sizeof cache, "%s/cache", dir);
+    setenv("MURK_CACHE_DIR", cache, 1);
+    snprintf(path, sizeof path, "%s/tiny.yaml", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(scene, f);
+    fclose(f);
+    snprintf(out, sizeof out, "%s/out", dir);
+    char *args[] = {path, "--vary", "media.smoke.type=delta,decomposition", "--spp", "1,2", "--repeat", "2",
+                    "--ref-spp", "8", "--no-charts", "-o", out, NULL};
+    int argc = (int)(sizeof args / sizeof args[0]) - 1;
+    volatile sig_atomic_t stop = 0;
+    static rows_seen seen;
+    seen = (rows_seen){.stop = &stop};
+    assert_int_equal(murk_lab_bench_run(argc, args, &stop, on_row, &seen), 0);
+    assert_int_equal(seen.n, 8); /* 2 variants x 2 budgets x 2 seeds */
+    assert_int_equal(same_lines(out, "bench.csv", &seen), 8);
+
+    /* the caller's stop flag, set after the third row: the third render is the last */
+    snprintf(out2, sizeof out2, "%s/out2", dir);
+    args[11] = out2;
+    stop = 0;
+    seen = (rows_seen){.stop = &stop, .stop_after = 3};
+    assert_int_equal(murk_lab_bench_run(argc, args, &stop, on_row, &seen), 130);
+    assert_int_equal(seen.n, 3);
+    assert_int_equal(same_lines(out2, "bench-interrupted.csv", &seen), 3);
+
+    char *jobs[] = {path, "--emit-jobs", out2, NULL};
+    assert_int_equal(murk_lab_bench_run(3, jobs, NULL, NULL, NULL), 2);
+    nftw(dir, remove_one, 16, FTW_DEPTH | FTW_PHYS);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(metrics_closed_form),
         cmocka_unit_test(schema_as_data),
+        cmocka_unit_test(bench_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

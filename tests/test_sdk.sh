@@ -8,7 +8,9 @@
 #   3. copy the installed share/murk/examples, build them out of tree with their own meson.build and
 #      the installed murk-plugin.pc (PKG_CONFIG_PATH into the temporary prefix);
 #   4. the installed murk lists them (MURK_PLUGIN_PATH), `murk check`s each one, and renders a scene
-#      that names all three (material, tracker, integrator).
+#      that names all three (material, tracker, integrator);
+#   5. the installed murk benches that scene (charts from the installed chart script), and a program
+#      built against the installed murk-lab.pc reads a plugin's schema through murk/lab.h.
 # Usage: test_sdk.sh MESON   (the meson executable); MURK_BUILD_ROOT is the build folder (meson test
 # sets it). Writes nothing outside one temporary folder, which it removes.
 set -eu
@@ -120,4 +122,34 @@ EOF
 "$MURK" render "$TMP/examples.yaml" -o "$TMP/examples_vol.exr" --threads 2 --set integrator.type=volpath_nee ||
   fail "murk render with volpath_nee and example_delta"
 "$MURK" compare "$TMP/examples_vol.exr" "$TMP/examples.exr" || fail "the rendered EXRs do not read back"
+step "murk bench with the installed murk (its chart script found beside the installed libmurklab)"
+MURK_CACHE_DIR="$TMP/cache" "$MURK" bench "$TMP/examples.yaml" --spp 1,2 --repeat 2 --ref-spp 4 \
+  --set 'render.resolution=[8,6]' -o "$TMP/bench" >"$TMP/bench.log" 2>&1 || { cat "$TMP/bench.log"; fail "murk bench"; }
+for f in bench.csv bench.json report.md report.html maps/variant0.npy; do
+  [ -s "$TMP/bench/$f" ] || { cat "$TMP/bench.log"; fail "murk bench wrote no $f"; }
+done
+
+step "a program on the installed murk-lab.pc: a plugin's schema through murk/lab.h"
+cat >"$TMP/schema.c" <<'EOF'
+#include <stdio.h>
+#include "murk/lab.h"
+int main(void)
+{
+    char err[1024];
+    murk_lab_plugin_info info;
+    murk_lab_plugin *p = murk_lab_plugin_open("example_matte", &info, err, sizeof err);
+    if (!p) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    printf("%s: %u parameters, the first %s\n", info.name, info.nparams, info.nparams ? info.params[0].name : "-");
+    murk_lab_plugin_close(p);
+    return 0;
+}
+EOF
+# shellcheck disable=SC2046 # pkg-config's flags are words
+cc -std=c11 -Wall -Wextra -Werror $(pkg-config --cflags murk-lab) -o "$TMP/schema" "$TMP/schema.c" \
+  $(pkg-config --libs murk-lab) || fail "building against murk-lab.pc"
+LD_LIBRARY_PATH=$(dirname "$LIBLAB") "$TMP/schema" || fail "the program on libmurklab"
+
 echo "sdk: all steps passed"

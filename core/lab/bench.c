@@ -5,6 +5,7 @@
  * the charts and report.md, and writes DIR/report.html, the comparison page (lab/report_html.h): each
  * variant's first-seed image at the largest budget, the reference, the error maps, charts and tables.
  * Part of libmurklab (murk/lab.h). */
+#define _GNU_SOURCE /* dladdr() */
 #include "cmd/cmd.h"
 #include "image/image.h"
 #include "lab/report_html.h"
@@ -18,6 +19,7 @@
 #include "util/util.h"
 #include "murk/lab.h"
 
+#include <dlfcn.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -48,7 +50,10 @@ typedef struct bench {
     int nbudgets, time_mode, repeat, threads, ref_spp, charts;
     const char *jobs; /* --emit-jobs DIR or --assemble DIR */
     int assemble;
-    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM/SIGHUP (murk_cli_catch_stop_signals) */
+    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM/SIGHUP (murk_cli_catch_stop_signals), or the caller's */
+    int command;                 /* run as `murk bench`: it catches the stop signals, and may --emit-jobs */
+    murk_bench_row_fn row;       /* murk_lab_bench_run's callback, NULL for the command */
+    void *user;
 } bench;
 
 enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
@@ -576,26 +581,27 @@ static int npy_fill(FILE *f, const char *tmp, void *user, char *err, size_t errl
     return 0;
 }
 
-/* Where the chart script is: $MURK_BENCH_SCRIPT; beside the build tree's murk (build/tools/); where an
- * install put it relative to bin/murk (so a relocated or --destdir install finds it); the install path. */
+/* Where the chart script is: $MURK_BENCH_SCRIPT; beside the build tree's libmurklab (build/tools/); where
+ * an install put it relative to the libmurklab in use (so a relocated or --destdir install finds it,
+ * whatever program runs the lab); the install path. */
 static void script_path(char *buf, size_t n)
 {
+    static const char anchor = 0; /* an address inside libmurklab */
     const char *env = getenv("MURK_BENCH_SCRIPT");
     if (env && *env) {
         snprintf(buf, n, "%s", env);
         return;
     }
-    char exe[4096];
-    ssize_t l = n > sizeof exe + 64 ? readlink("/proc/self/exe", exe, sizeof exe - 1) : -1;
-    if (l > 0) {
-        exe[l] = 0;
-        char *slash = strrchr(exe, '/');
+    Dl_info info;
+    char lib[4096];
+    if (dladdr(&anchor, &info) && info.dli_fname && realpath(info.dli_fname, lib) && n > sizeof lib + 64) {
+        char *slash = strrchr(lib, '/');
         if (slash) {
             *slash = 0;
-            snprintf(buf, n, "%s/../tools/bench_report.py", exe);
+            snprintf(buf, n, "%s/../tools/bench_report.py", lib);
             if (access(buf, R_OK) == 0)
                 return;
-            snprintf(buf, n, "%s/%s", exe, MURK_BENCH_SCRIPT_FROM_BINDIR);
+            snprintf(buf, n, "%s/%s", lib, MURK_BENCH_SCRIPT_FROM_LIBDIR);
             if (access(buf, R_OK) == 0)
                 return;
         }
@@ -790,22 +796,7 @@ static int write_page(murk_html_page *page, const bench *b, int rc)
     return rc;
 }
 
-/* One row of bench.csv: a whole render, its work and its figures against the reference. */
-typedef struct bench_row {
-    int variant;            /* the variant's index (the last --vary varies fastest) */
-    const char *label;      /* "type=delta majorant_factor=4" (variant_label) */
-    double budget;          /* spp, or seconds with --time */
-    int seed;               /* 1 .. --repeat */
-    int spp;                /* rendered */
-    double seconds;         /* the render's time */
-    uint64_t rays;
-    murk_counters counters; /* summed over the media */
-    murk_metrics metrics;   /* against the reference (its noise subtracted when known) */
-    uint64_t nonfinite;     /* the render's non-finite samples plus the pixel-channels the metrics skipped */
-    double max_sample;      /* the render's largest finite sample */
-} bench_row;
-
-static void csv_row(FILE *csv, const bench_row *w)
+static void csv_row(FILE *csv, const murk_bench_row *w)
 {
     const murk_metrics *m = &w->metrics;
     fprintf(csv, "%d,", w->variant);
@@ -904,12 +895,14 @@ static void record(run *u, int v, int bi, int k, const char *label, const murk_r
 {
     const bench *b = u->b;
     const reference *r = &u->r;
-    bench_row w = {.variant = v, .label = label, .budget = b->budgets[bi], .seed = 1 + k, .spp = res->spp,
+    murk_bench_row w = {.variant = v, .label = label, .budget = b->budgets[bi], .seed = 1 + k, .spp = res->spp,
                    .seconds = res->seconds, .rays = res->rays, .counters = murk_counters_total(res),
                    .max_sample = res->max_sample};
     murk_metrics_compute(res->rgb, r->rgb, r->var, r->w, (murk_crop){0, 0, r->w, r->h}, &w.metrics, u->pix);
     w.nonfinite = res->nonfinite + w.metrics.nonfinite;
     csv_row(u->csv, &w);
+    if (b->row)
+        b->row(b->user, &w);
     if (bi == u->big) {
         for (size_t p = 0; p < u->np; p++)
             u->maps[(size_t)v * u->np + p] += isfinite(u->pix[p]) ? u->pix[p] / b->repeat : 0.0;
@@ -1420,7 +1413,8 @@ static int bench_main(bench *b, int argc, char **argv)
     }
     struct stat st;
     int made_out = stat(b->out, &st) != 0;
-    b->stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
+    if (b->command)
+        b->stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
     if (mkdirs(b->out) != 0) {
         fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b->out), strerror(errno));
         return 1;
@@ -1437,9 +1431,10 @@ static int bench_main(bench *b, int argc, char **argv)
     return rc;
 }
 
-MURK_API int murk_lab_bench(int argc, char **argv)
+static int bench_entry(int argc, char **argv, volatile sig_atomic_t *stop, murk_bench_row_fn row, void *user,
+                       int command)
 {
-    bench b = {.repeat = 3, .charts = 1};
+    bench b = {.repeat = 3, .charts = 1, .stop = stop, .command = command, .row = row, .user = user};
     b.sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.sets);
     b.ref_sets = murk_xmalloc((size_t)(argc + 1) * sizeof *b.ref_sets);
     b.vary = murk_xmalloc((size_t)(argc + 1) * sizeof *b.vary);
@@ -1449,8 +1444,19 @@ MURK_API int murk_lab_bench(int argc, char **argv)
         rc = bench_option(&b, argc, argv, &i);
     if (rc == 0)
         rc = bench_defaults(&b, outbuf, sizeof outbuf);
+    if (rc == 0 && b.jobs && !b.assemble && !command) {
+        fprintf(stderr, "murk: --emit-jobs writes jobs that run the murk command: give it to `murk bench`\n");
+        rc = 2;
+    }
     if (rc == 0)
         rc = bench_main(&b, argc, argv);
     bench_free(&b);
     return rc < 0 ? 0 : rc;
+}
+
+MURK_API int murk_lab_bench(int argc, char **argv) { return bench_entry(argc, argv, NULL, NULL, NULL, 1); }
+
+MURK_API int murk_lab_bench_run(int argc, char **argv, volatile sig_atomic_t *stop, murk_bench_row_fn row, void *user)
+{
+    return bench_entry(argc, argv, stop, row, user, 0);
 }

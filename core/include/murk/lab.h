@@ -5,9 +5,11 @@
 #ifndef MURK_LAB_H
 #define MURK_LAB_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "murk/counters.h"
 #include "murk/plugin.h"
 
 /* The commands, as the murk command runs them: argv holds the arguments after the command's name
@@ -40,6 +42,34 @@ typedef struct murk_metrics {
  * c.w x c.h floats: each pixel's channel-mean of the corrected relative squared error. */
 void murk_metrics_compute(const float *a, const float *r, const float *v, int w, murk_crop c, murk_metrics *m,
                           float *pix);
+
+/* ---- A bench, row by row ---- */
+
+/* One row of bench.csv (its columns, in order): a whole render, its work and its figures against the
+ * reference. */
+typedef struct murk_bench_row {
+    int variant;            /* the variant's index (the cross product of the --vary lists, the last fastest) */
+    const char *label;      /* its --vary values: "type=delta majorant_factor=4" ("scene" without --vary) */
+    double budget;          /* spp, or seconds with --time */
+    int seed;               /* 1 .. --repeat */
+    int spp;                /* rendered */
+    double seconds;         /* the render's time */
+    uint64_t rays;
+    murk_counters counters; /* summed over the scene's media (murk/counters.h) */
+    murk_metrics metrics;   /* against the reference, its noise subtracted when known */
+    uint64_t nonfinite;     /* the render's non-finite samples plus the pixel-channels the metrics skipped */
+    double max_sample;      /* the render's largest finite sample */
+} murk_bench_row;
+
+/* Called once per whole render, as its row is added; row and its label live until the call returns. */
+typedef void (*murk_bench_row_fn)(void *user, const murk_bench_row *row);
+
+/* `murk bench` with the command's arguments and files (bench.csv, maps, bench.json, charts, report.html),
+ * for a program: each row also handed to row(user, ...) (row may be NULL), and no signal handlers set.
+ * stop, if not NULL, plays their part: once *stop is set the running render is abandoned and the bench
+ * ends as the command does on SIGINT (bench-interrupted.csv with the whole renders' rows; status 130).
+ * --emit-jobs is refused (status 2): its jobs run the murk command. Returns the command's exit status. */
+int murk_lab_bench_run(int argc, char **argv, volatile sig_atomic_t *stop, murk_bench_row_fn row, void *user);
 
 /* ---- Plugins' schemas as data: what `murk plugins NAME` prints ---- */
 
