@@ -4,62 +4,25 @@
  * DIR/bench.csv, DIR/bench.json and DIR/maps/, runs the chart script (tools/bench_report.py) for
  * the charts and report.md, and writes DIR/report.html, the comparison page (lab/report_html.h): each
  * variant's first-seed image at the largest budget, the reference, the error maps, charts and tables.
- * Part of libmurklab (murk/lab.h). */
-#define _GNU_SOURCE /* dladdr() */
+ * This file: the options, the variants and their --set lists, checking that every variant loads before
+ * anything is rendered, and the entry points (murk/lab.h); the rest is in bench_run.c, bench_ref.c and
+ * bench_jobs.c (bench.h). Part of libmurklab. */
+#include "lab/bench.h"
+
 #include "cmd/cmd.h"
-#include "image/image.h"
 #include "lab/report_html.h"
 #include "load/load.h"
-#include "media/media.h"
-#include "render/counters.h"
 #include "scene/scene.h"
-#include "util/atomic.h"
-#include "util/limit.h"
 #include "util/runtime.h"
 #include "util/util.h"
-#include "murk/lab.h"
 
-#include <dlfcn.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
-
-static const char *const counter_names[MURK_NCOUNTERS] = MURK_COUNTER_NAMES;
-
-/* ---- murk bench ---------------------------------------------------------------------------- */
-
-typedef struct vary {
-    const char *arg; /* KEY=V1,V2,... as given */
-    char *key;
-    char **vals;
-    int nvals;
-} vary;
-
-typedef struct bench {
-    const char *scene, *out, *reference;
-    const char **sets, **ref_sets;
-    size_t nsets, nref_sets;
-    vary *vary;
-    int nvary, nvariants;
-    double *budgets;
-    int nbudgets, time_mode, repeat, threads, ref_spp, charts;
-    const char *jobs; /* --emit-jobs DIR or --assemble DIR */
-    int assemble;
-    volatile sig_atomic_t *stop; /* set by SIGINT/SIGTERM/SIGHUP (murk_cli_catch_stop_signals), or the caller's */
-    int command;                 /* run as `murk bench`: it catches the stop signals, and may --emit-jobs */
-    murk_bench_row_fn row;       /* murk_lab_bench_run's callback, NULL for the command */
-    void *user;
-} bench;
-
-enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
-
-/* A signal asked the bench to stop. */
-static int stopped(const bench *b) { return b->stop && *b->stop; }
 
 static char **split_list(const char *s, int *n)
 {
@@ -116,7 +79,7 @@ static const char *vary_name(const bench *b, int j)
 }
 
 /* "type=delta majorant_factor=4": each --vary key's short name and the variant's value. */
-static void variant_label(const bench *b, int i, char *buf, size_t n)
+void murk_bench_label(const bench *b, int i, char *buf, size_t n)
 {
     size_t k = 0;
     buf[0] = 0;
@@ -129,7 +92,7 @@ static void variant_label(const bench *b, int i, char *buf, size_t n)
 
 /* The --set list of a render: the common sets, variant i's values (i < 0: the reference's sets) and
  * the seed (seed < 0: the scene's). Strings are kept in store (freed by the caller). */
-static size_t render_sets(const bench *b, int i, long seed, const char **out, char **store, size_t *nstore)
+size_t murk_bench_sets(const bench *b, int i, long seed, const char **out, char **store, size_t *nstore)
 {
     size_t n = 0;
     for (size_t k = 0; k < b->nsets; k++)
@@ -153,7 +116,7 @@ static size_t render_sets(const bench *b, int i, long seed, const char **out, ch
     return n;
 }
 
-static void free_store(char **store, size_t *n)
+void murk_bench_free_sets(char **store, size_t *n)
 {
     for (size_t i = 0; i < *n; i++)
         free(store[i]);
@@ -208,7 +171,7 @@ static int check_vary_key(const murk_scene *s, const vary *v, char *err, size_t 
 
 /* A variant's scene as `murk render` loads it: with the rule that every medium and material is used, so a
  * misspelt medium in a --vary or --set fails here instead of adding an unused block. */
-static murk_scene *load_with(const bench *b, const char *const *sets, size_t nsets, char *err, size_t errlen)
+murk_scene *murk_bench_load(const bench *b, const char *const *sets, size_t nsets, char *err, size_t errlen)
 {
     murk_scene *s = murk_scene_load(b->scene, sets, nsets, err, errlen);
     if (s && murk_scene_check_unused(s, err, errlen)) {
@@ -224,7 +187,7 @@ static int validate(const bench *b)
 {
     char err[2048];
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    murk_scene *s = load_with(b, b->sets, b->nsets, err, sizeof err);
+    murk_scene *s = murk_bench_load(b, b->sets, b->nsets, err, sizeof err);
     int rc = 0;
     if (!s) {
         fprintf(stderr, "%s\n", err);
@@ -244,7 +207,7 @@ static int validate(const bench *b)
             for (size_t q = 0; q < b->nsets; q++)
                 sets[n++] = b->sets[q];
             sets[n++] = one;
-            murk_scene *t = load_with(b, sets, n, err, sizeof err);
+            murk_scene *t = murk_bench_load(b, sets, n, err, sizeof err);
             if (!t) {
                 fprintf(stderr, "%s\nmurk: bench: in --vary %s (value '%s'); nothing was rendered\n", err,
                         murk_cli_q(b->vary[j].arg), murk_cli_q(b->vary[j].vals[k]));
@@ -258,13 +221,14 @@ static int validate(const bench *b)
     for (int i = -1; i < b->nvariants && !rc; i++) {
         if (i < 0 && !b->nref_sets)
             continue;
-        size_t n = render_sets(b, i, -1, sets, store, &nstore);
-        murk_scene *t = load_with(b, sets, n, err, sizeof err);
+        size_t n = murk_bench_sets(b, i, -1, sets, store, &nstore);
+        murk_scene *t = murk_bench_load(b, sets, n, err, sizeof err);
         char label[1024];
-        variant_label(b, i < 0 ? 0 : i, label, sizeof label);
+        murk_bench_label(b, i < 0 ? 0 : i, label, sizeof label);
         if (!t) {
-            fprintf(stderr, "%s\nmurk: bench: in %s%s%s; nothing was rendered\n", err, i < 0 ? "the reference's --ref-set" : "variant '",
-                    i < 0 ? "" : murk_cli_q(label), i < 0 ? "" : "'");
+            fprintf(stderr, "%s\nmurk: bench: in %s%s%s; nothing was rendered\n", err,
+                    i < 0 ? "the reference's --ref-set" : "variant '", i < 0 ? "" : murk_cli_q(label),
+                    i < 0 ? "" : "'");
             rc = -1;
         } else if (t->width != s->width || t->height != s->height) {
             fprintf(stderr, "murk: bench: %s has another resolution than the scene; nothing was rendered\n",
@@ -272,24 +236,14 @@ static int validate(const bench *b)
             rc = -1;
         }
         murk_scene_free(t);
-        free_store(store, &nstore);
+        murk_bench_free_sets(store, &nstore);
     }
     murk_scene_free(s);
     free(sets);
     return rc;
 }
 
-/* ---- the reference ---- */
-
-static uint64_t fnv(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *c = p;
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ c[i]) * 1099511628211ull;
-    return h;
-}
-
-static int mkdirs(const char *path)
+int murk_bench_mkdirs(const char *path)
 {
     char *p = murk_strdup(path);
     for (char *s = p + 1; *s; s++)
@@ -301,322 +255,6 @@ static int mkdirs(const char *path)
     int rc = mkdir(p, 0777) == 0 || errno == EEXIST ? 0 : -1;
     free(p);
     return rc;
-}
-
-static void cache_dir(char *buf, size_t n)
-{
-    const char *d = getenv("MURK_CACHE_DIR"), *x = getenv("XDG_CACHE_HOME"), *h = getenv("HOME");
-    if (d && *d)
-        snprintf(buf, n, "%s", d);
-    else if (x && *x)
-        snprintf(buf, n, "%s/murk", x);
-    else
-        snprintf(buf, n, "%s/.cache/murk", h && *h ? h : "/tmp");
-}
-
-typedef struct reference {
-    int w, h;
-    float *rgb, *var; /* var: the variance of rgb's per-pixel mean; NULL if unknown */
-    char path[4096];
-    int reused, spp;
-    double seconds;
-} reference;
-
-static void ref_free(reference *r)
-{
-    free(r->rgb);
-    free(r->var);
-}
-
-static int read_exr(const char *path, int w, int h, float **out)
-{
-    murk_image im = {0};
-    char err[1024];
-    if (murk_exr_read(path, &im, err, sizeof err) || im.w != w || im.h != h) {
-        murk_image_free(&im);
-        return -1;
-    }
-    *out = im.rgb;
-    im.rgb = NULL;
-    murk_image_free(&im);
-    return 0;
-}
-
-/* ---- sweeps as jobs (--emit-jobs DIR, --assemble DIR) ---- */
-
-/* Where job (variant v, budget bi, seed k) writes its image; v < 0: reference chunk k. */
-static void job_out(const bench *b, int v, int bi, int k, char *buf, size_t n)
-{
-    if (v < 0)
-        snprintf(buf, n, "%s/renders/ref%d.exr", b->jobs, k);
-    else
-        snprintf(buf, n, "%s/renders/v%d-b%d-s%d.exr", b->jobs, v, bi, k);
-}
-
-/* The value of "NAME": N in a murk:counters JSON text (0 if absent). */
-static uint64_t json_u64(const char *json, const char *name)
-{
-    char key[64];
-    snprintf(key, sizeof key, "\"%s\": ", name);
-    const char *p = json ? strstr(json, key) : NULL;
-    return p ? strtoull(p + strlen(key), NULL, 10) : 0;
-}
-
-/* A job's image read back as murk_render_err would have returned it: pixels, spp, seconds, rays, the
- * counters' totals (as one medium), NaN count and largest sample. 0, or -1 after a message naming it. */
-static int read_job(const char *path, int w, int h, murk_render_result *res)
-{
-    murk_image im = {0};
-    char err[1024];
-    memset(res, 0, sizeof *res);
-    if (murk_exr_read(path, &im, err, sizeof err) != 0 || im.w != w || im.h != h ||
-        !murk_image_meta(&im, "murk:counters") || strcmp(murk_image_meta(&im, "murk:interrupted"), "no") != 0) {
-        fprintf(stderr, "murk: %s\nmurk: %s: not the finished %dx%d render of its job (run it again: the line "
-                "of jobs.txt that writes it)\n", im.rgb ? "" : err, murk_cli_q(path), w, h);
-        murk_image_free(&im);
-        return -1;
-    }
-    const char *json = murk_image_meta(&im, "murk:counters"), *total = strstr(json, "\"total\": ");
-    uint64_t t[MURK_NCOUNTERS];
-    for (int k = 0; k < MURK_NCOUNTERS; k++)
-        t[k] = json_u64(total, counter_names[k]);
-    res->media[0] = (murk_counters){t[0], t[1], t[2], t[3], t[4]};
-    res->nmedia = 1;
-    res->rays = json_u64(json, "rays");
-    res->spp = atoi(murk_image_meta(&im, "murk:spp"));
-    res->seconds = strtod(murk_image_meta(&im, "murk:render_time"), NULL);
-    res->nonfinite = strtoull(murk_image_meta(&im, "murk:nonfinite_samples"), NULL, 10);
-    const char *mx = murk_image_meta(&im, "murk:max_sample");
-    res->max_sample = mx ? strtod(mx, NULL) : 0.0;
-    res->width = w, res->height = h;
-    res->rgb = im.rgb;
-    im.rgb = NULL;
-    murk_image_free(&im);
-    return 0;
-}
-
-/* Renders (or, --assemble, reads) one render of the bench. 0; 1 when a signal abandoned it (no image:
- * only whole renders count); or -1 after a message. */
-static int bench_render(const bench *b, int v, int bi, int k, const char *const *sets, size_t n,
-                        const murk_render_opts *o, int w, int h, murk_render_result *res)
-{
-    char err[2048], path[4200];
-    if (b->assemble) {
-        job_out(b, v, bi, k, path, sizeof path);
-        return read_job(path, w, h, res);
-    }
-    murk_scene *s = load_with(b, sets, n, err, sizeof err);
-    if (!s) {
-        fprintf(stderr, "\n%s\n", err);
-        memset(res, 0, sizeof *res);
-        return -1;
-    }
-    int rc = murk_render_err(s, o, res, err, sizeof err);
-    if (rc != 0)
-        fprintf(stderr, "\nmurk: %s\n", err);
-    murk_scene_free(s);
-    if (rc == 0 && res->interrupted) {
-        free(res->rgb);
-        res->rgb = NULL;
-        return 1;
-    }
-    return rc ? -1 : 0;
-}
-
-/* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
- * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
- * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the content hash of the scene file and
- * of every file it loads, the --set overrides, the spp and murk's version: the mean and the variance as
- * one group of atomic writes (both files or neither). A stop signal abandons it (-1, nothing cached). */
-static int make_reference(const bench *b, reference *r)
-{
-    char err[2048], dir[3072];
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
-    size_t nstore = 0, n = render_sets(b, -1, -1, sets, store, &nstore);
-    /* the scene file and every file it loads (meshes, grids, textures), as a checkpoint hashes them */
-    murk_scene *hs = load_with(b, sets, n, err, sizeof err);
-    uint64_t sh = hs ? murk_scene_hash(hs, err, sizeof err) : 0;
-    murk_scene_free(hs);
-    if (!sh) {
-        fprintf(stderr, "%s\n", err);
-        free_store(store, &nstore);
-        free(sets);
-        return -1;
-    }
-    uint64_t h = fnv(1469598103934665603ull, "murk bench reference 1", 23);
-    h = fnv(h, MURK_VERSION, sizeof MURK_VERSION);
-    h = fnv(h, &sh, sizeof sh);
-    h = fnv(h, &b->ref_spp, sizeof b->ref_spp);
-    for (size_t i = 0; i < n; i++)
-        h = fnv(h, sets[i], strlen(sets[i]) + 1);
-    cache_dir(dir, sizeof dir);
-    char var_path[4200];
-    snprintf(r->path, sizeof r->path, "%s/bench-ref-%016llx.exr", dir, (unsigned long long)h);
-    snprintf(var_path, sizeof var_path, "%s/bench-ref-%016llx-var.exr", dir, (unsigned long long)h);
-    r->spp = b->ref_spp;
-    if (!b->assemble && read_exr(r->path, r->w, r->h, &r->rgb) == 0 &&
-        read_exr(var_path, r->w, r->h, &r->var) == 0) {
-        r->reused = 1;
-        free_store(store, &nstore);
-        free(sets);
-        return 0;
-    }
-    free(r->rgb);
-    r->rgb = NULL;
-    size_t np = (size_t)r->w * (size_t)r->h * 3;
-    double *s1 = calloc(np, sizeof *s1), *s2 = calloc(np, sizeof *s2);
-    int rc = s1 && s2 ? 0 : -1;
-    for (int c = 0; c < REF_CHUNKS && rc == 0; c++) {
-        char seed[40];
-        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
-        sets[n] = seed;
-        murk_render_opts o = {.spp = (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, .threads = b->threads,
-                              .stop = b->stop};
-        if (stopped(b)) {
-            rc = -1;
-            break;
-        }
-        murk_render_result res;
-        if (murk_cli_progress() && !b->assemble)
-            fprintf(stderr, "\rmurk bench: reference chunk %d of %d (%d spp)...   ", c + 1, REF_CHUNKS, o.spp);
-        if (bench_render(b, -1, 0, c, sets, n + 1, &o, r->w, r->h, &res) != 0) {
-            rc = -1;
-        } else {
-            for (size_t i = 0; i < np; i++) {
-                s1[i] += res.rgb[i];
-                s2[i] += (double)res.rgb[i] * res.rgb[i];
-            }
-            r->seconds += res.seconds;
-        }
-        free(res.rgb);
-    }
-    if (murk_cli_progress() && !b->assemble)
-        fputc('\n', stderr);
-    if (rc == 0) {
-        r->rgb = murk_xmalloc(np * sizeof(float));
-        r->var = murk_xmalloc(np * sizeof(float));
-        for (size_t i = 0; i < np; i++) {
-            double m = s1[i] / REF_CHUNKS, v = (s2[i] - s1[i] * m) / (REF_CHUNKS - 1);
-            r->rgb[i] = (float)m;
-            r->var[i] = (float)(fmax(v, 0.0) / REF_CHUNKS);
-        }
-        char spp[32];
-        snprintf(spp, sizeof spp, "%d", REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS));
-        murk_kv meta[] = {{"murk:scene", b->scene}, {"murk:spp", spp}, {"murk:version", MURK_VERSION},
-                          {"murk:bench", "reference: the mean of 4 chunks"}};
-        murk_kv vmeta[] = {{"murk:scene", b->scene}, {"murk:bench", "variance of the reference's per-pixel mean"}};
-        err[0] = 0;
-        murk_output_begin();
-        if (mkdirs(dir) != 0 || murk_exr_write(r->path, r->rgb, r->w, r->h, meta, 4, err, sizeof err) != 0 ||
-            murk_exr_write(var_path, r->var, r->w, r->h, vmeta, 2, err, sizeof err) != 0 ||
-            murk_output_commit(err, sizeof err) != 0) {
-            murk_output_abort();
-            fprintf(stderr, "murk: warning: could not cache the reference in %s (%s); it will be rendered again "
-                    "next time\n", murk_cli_q(dir), err[0] ? err : strerror(errno));
-        }
-    }
-    free(s1);
-    free(s2);
-    free_store(store, &nstore);
-    free(sets);
-    return rc;
-}
-
-/* ---- output ---- */
-
-static void json_str(FILE *f, const char *s) { murk_html_json_string(f, s, strlen(s)); }
-
-static void csv_str(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; s++) {
-        if (*s == '"')
-            fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
-}
-
-/* Every output file of the bench goes through murk_write_atomic (atomic.h): a temporary beside it,
- * renamed over it when whole. These fill the temporary. */
-
-typedef struct text_job {
-    const char *p;
-    size_t n;
-} text_job;
-
-static int text_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
-{
-    const text_job *t = user;
-    (void)tmp, (void)err, (void)errlen;
-    fwrite(t->p, 1, t->n, f); /* murk_write_atomic checks the stream */
-    return 0;
-}
-
-typedef struct npy_job {
-    const float *v;
-    int w, h;
-} npy_job;
-
-/* A float32 .npy file of h x w values (numpy's format 1.0). */
-static int npy_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
-{
-    const npy_job *j = user;
-    const float *v = j->v;
-    int w = j->w, h = j->h;
-    (void)tmp, (void)err, (void)errlen;
-    char head[128];
-    int n = snprintf(head, sizeof head, "{'descr': '<f4', 'fortran_order': False, 'shape': (%d, %d), }", h, w);
-    int total = 10 + n + 1, pad = (64 - total % 64) % 64;
-    unsigned short hl = (unsigned short)(n + pad + 1);
-    fwrite("\x93NUMPY\x01\x00", 1, 8, f);
-    fputc(hl & 0xff, f);
-    fputc(hl >> 8, f);
-    fwrite(head, 1, (size_t)n, f);
-    for (int i = 0; i < pad; i++)
-        fputc(' ', f);
-    fputc('\n', f);
-    fwrite(v, sizeof(float), (size_t)w * (size_t)h, f);
-    return 0;
-}
-
-/* Where the chart script is: $MURK_BENCH_SCRIPT; beside the build tree's libmurklab (build/tools/); where
- * an install put it relative to the libmurklab in use (so a relocated or --destdir install finds it,
- * whatever program runs the lab); the install path. */
-static void script_path(char *buf, size_t n)
-{
-    static const char anchor = 0; /* an address inside libmurklab */
-    const char *env = getenv("MURK_BENCH_SCRIPT");
-    if (env && *env) {
-        snprintf(buf, n, "%s", env);
-        return;
-    }
-    Dl_info info;
-    char lib[4096];
-    if (dladdr(&anchor, &info) && info.dli_fname && realpath(info.dli_fname, lib) && n > sizeof lib + 64) {
-        char *slash = strrchr(lib, '/');
-        if (slash) {
-            *slash = 0;
-            snprintf(buf, n, "%s/../tools/bench_report.py", lib);
-            if (access(buf, R_OK) == 0)
-                return;
-            snprintf(buf, n, "%s/%s", lib, MURK_BENCH_SCRIPT_FROM_LIBDIR);
-            if (access(buf, R_OK) == 0)
-                return;
-        }
-    }
-    snprintf(buf, n, "%s", MURK_BENCH_SCRIPT_INSTALLED);
-}
-
-static void fmt_eta(double s, char *buf, size_t n)
-{
-    if (s >= 3600)
-        snprintf(buf, n, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
-    else if (s >= 60)
-        snprintf(buf, n, "%dm%02ds", (int)(s / 60), (int)fmod(s, 60));
-    else
-        snprintf(buf, n, "%.0fs", s);
 }
 
 static int parse_budgets(const char *opt, const char *v, int time_mode, bench *b)
@@ -640,606 +278,6 @@ static int parse_budgets(const char *opt, const char *v, int time_mode, bench *b
     }
     free_list(parts, n);
     return rc;
-}
-
-/* ---- the runs ---- */
-
-/* " WORD" as a POSIX shell reads it back: plain, or in single quotes. */
-static void shell_word(FILE *f, const char *w)
-{
-    int plain = *w != 0;
-    for (const char *p = w; *p; p++)
-        if (!strchr("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=.,/:+@%", *p))
-            plain = 0;
-    if (plain) {
-        fprintf(f, " %s", w);
-        return;
-    }
-    fputs(" '", f);
-    for (const char *p = w; *p; p++)
-        fputs(*p == '\'' ? "'\\''" : (char[2]){*p, 0}, f);
-    fputc('\'', f);
-}
-
-static void shell_quoted(FILE *f, int argc, char **argv)
-{
-    fputs("murk bench", f);
-    for (int i = 0; i < argc; i++)
-        shell_word(f, argv[i]);
-}
-
-typedef struct meta_job {
-    const bench *b;
-    const reference *r;
-    int argc;
-    char **argv;
-} meta_job;
-
-/* bench.json: what the chart script needs besides bench.csv. */
-static int meta_fill(FILE *f, const char *tmp, void *user, char *err, size_t errlen)
-{
-    const meta_job *j = user;
-    const bench *b = j->b;
-    const reference *r = j->r;
-    int argc = j->argc;
-    char **argv = j->argv;
-    (void)tmp, (void)err, (void)errlen;
-    char cmd[65536];
-    FILE *m = fmemopen(cmd, sizeof cmd, "w");
-    if (m) {
-        shell_quoted(m, argc, argv);
-        fclose(m);
-    } else {
-        snprintf(cmd, sizeof cmd, "murk bench %s", b->scene);
-    }
-    fprintf(f, "{\n  \"command\": ");
-    json_str(f, cmd);
-    fprintf(f, ",\n  \"version\": \"%s\",\n  \"scene\": ", MURK_VERSION);
-    json_str(f, b->scene);
-    fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %d,\n", b->time_mode ? "seconds" : "spp",
-            b->repeat, b->threads, murk_cpus_usable());
-    fprintf(f, "  \"reference\": {\"path\": ");
-    json_str(f, b->reference ? b->reference : r->path);
-    fprintf(f, ", \"given\": %s, \"reused\": %s, \"spp\": %d, \"seconds\": %.3f, \"noise_estimated\": %s, \"sets\": [",
-            b->reference ? "true" : "false", r->reused ? "true" : "false", b->reference ? 0 : r->spp, r->seconds,
-            r->var ? "true" : "false");
-    for (size_t i = 0; i < b->nref_sets; i++) {
-        fputs(i ? ", " : "", f);
-        json_str(f, b->ref_sets[i]);
-    }
-    fprintf(f, "]},\n  \"sets\": [");
-    for (size_t i = 0; i < b->nsets; i++) {
-        fputs(i ? ", " : "", f);
-        json_str(f, b->sets[i]);
-    }
-    fprintf(f, "],\n  \"vary\": [");
-    for (int j = 0; j < b->nvary; j++) {
-        fputs(j ? ", " : "", f);
-        json_str(f, b->vary[j].key);
-    }
-    fprintf(f, "],\n  \"variants\": [");
-    for (int i = 0; i < b->nvariants; i++) {
-        char label[1024];
-        variant_label(b, i, label, sizeof label);
-        fputs(i ? ", " : "", f);
-        json_str(f, label);
-    }
-    fprintf(f, "]\n}\n");
-    return 0;
-}
-
-/* The chart script (tools/bench_report.py DIR) as a child process, without a shell, once every render is
- * done and bench.csv, bench.json and maps/ are written. It runs in its own process group, so a Ctrl-C
- * reaches murk alone, and murk passes a SIGINT, SIGTERM or SIGHUP on to it once: the script then removes the
- * chart it was writing (every chart is a temporary renamed when whole). A signal that came before it
- * started: no charts. 0, or the exit status after a message. */
-static int run_charts(const bench *b)
-{
-    char script[8192];
-    script_path(script, sizeof script);
-    const char *py = getenv("MURK_PYTHON");
-    if (!py || !*py)
-        py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-    if (stopped(b)) {
-        fprintf(stderr, "murk bench: interrupted (%s) after the last render; bench.csv, bench.json and maps/ are "
-                "whole, no charts (%s %s %s makes them)\n", murk_cli_stop_name(), murk_cli_q(py), murk_cli_q(script),
-                murk_cli_q(b->out));
-        return murk_cli_stop_status();
-    }
-    if (!b->charts)
-        return 0;
-    fflush(stdout);
-    fflush(stderr);
-    pid_t pid = fork();
-    if (pid == 0) {
-        setpgid(0, 0);
-        execlp(py, py, script, b->out, (char *)NULL);
-        fprintf(stderr, "murk: cannot run %s: %s\n", murk_cli_q(py), strerror(errno));
-        _exit(127);
-    }
-    int st = -1, passed = 0;
-    while (pid > 0) {
-        if (stopped(b) && !passed) {
-            kill(pid, murk_cli_stop_status() - 128);
-            passed = 1;
-        }
-        if (waitpid(pid, &st, 0) == pid || errno != EINTR)
-            break;
-    }
-    if (stopped(b)) {
-        fprintf(stderr, "murk bench: interrupted (%s) while making the charts; bench.csv, bench.json and maps/ "
-                "are whole, some charts may be missing (%s %s %s makes them)\n", murk_cli_stop_name(), murk_cli_q(py),
-                murk_cli_q(script), murk_cli_q(b->out));
-        return murk_cli_stop_status();
-    }
-    if (pid < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-        fprintf(stderr, "murk: the chart script failed (%s %s: %s %d); bench.csv is complete. It needs python3 "
-                "with matplotlib and numpy (Debian: python3-matplotlib python3-numpy)\n", murk_cli_q(py),
-                murk_cli_q(script), pid < 0 ? "fork failed, errno" : WIFEXITED(st) ? "status" : "signal",
-                pid < 0 ? errno : WIFEXITED(st) ? WEXITSTATUS(st) : WTERMSIG(st));
-        return 1;
-    }
-    return 0;
-}
-
-/* DIR/report.html, once the bench's other files are written: rc (the chart script's status) or 1. */
-static int write_page(murk_html_page *page, const bench *b, int rc)
-{
-    char path[4200], err[8400];
-    snprintf(path, sizeof path, "%s/report.html", b->out);
-    murk_html_attach_bench(page, b->out);
-    if (murk_html_write(page, path, err, sizeof err) != 0) {
-        fprintf(stderr, "murk: %s\n", err);
-        return 1;
-    }
-    printf("comparison page: %s\n", murk_cli_q(path));
-    return rc;
-}
-
-static void csv_row(FILE *csv, const murk_bench_row *w)
-{
-    const murk_metrics *m = &w->metrics;
-    fprintf(csv, "%d,", w->variant);
-    csv_str(csv, w->label);
-    fprintf(csv, ",%g,%d,%d,%.6f,%llu", w->budget, w->seed, w->spp, w->seconds, (unsigned long long)w->rays);
-    for (int c = 0; c < MURK_NCOUNTERS; c++)
-        fprintf(csv, ",%llu", (unsigned long long)murk_counters_get(&w->counters, c));
-    fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m->mse, m->relmse, m->relmse_se, m->relmse_raw,
-            m->ref_noise, m->mare, (unsigned long long)w->nonfinite, w->max_sample);
-}
-
-/* One bench run: the reference, then what the sweep fills render by render and the end writes out. */
-typedef struct run {
-    const bench *b;
-    reference r;
-    FILE *csv;            /* bench.csv's text in memory (rows), written whole at the end */
-    char *rows;
-    size_t rows_len;
-    murk_html_page *page; /* report.html */
-    float *pix;           /* one render's per-pixel relMSE (murk_metrics_compute) */
-    double *maps;         /* per variant: the mean of pix over the seeds at the largest budget */
-    size_t np;
-    int big;              /* the largest budget's index */
-    int done, total;      /* whole renders recorded, and asked for */
-    double t0;
-} run;
-
-/* The reference: given (--reference), or rendered or taken from the cache (make_reference); said on
- * stdout. 0, 1 after a message, or the stop status when a signal came while rendering it. */
-static int load_reference(const bench *b, reference *r)
-{
-    if (b->reference) {
-        if (read_exr(b->reference, r->w, r->h, &r->rgb) != 0) {
-            fprintf(stderr, "murk: --reference %s: not a readable %dx%d EXR (the scene's resolution)\n",
-                    murk_cli_q(b->reference), r->w, r->h);
-            return 1;
-        }
-        printf("reference: %s (given; its own noise is not known, so relMSE is not corrected for it)\n",
-               murk_cli_q(b->reference));
-        return 0;
-    }
-    if (make_reference(b, r) != 0) {
-        if (!stopped(b))
-            return 1;
-        fprintf(stderr, "%smurk bench: interrupted (%s) while rendering the reference; nothing written\n",
-                murk_cli_progress() ? "\r\033[K" : "", murk_cli_stop_name());
-        return murk_cli_stop_status();
-    }
-    if (r->reused)
-        printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
-               murk_cli_q(r->path));
-    else
-        printf("reference: %s (rendered: %d spp in %d chunks, %.1f s; cached)\n", murk_cli_q(r->path),
-               REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS, r->seconds);
-    return 0;
-}
-
-/* bench.csv's header, the buffers of the maps, and the comparison page with the reference on it. 0, or 1
- * after a message. */
-static int run_open(run *u)
-{
-    const bench *b = u->b;
-    char title[8192];
-    u->csv = open_memstream(&u->rows, &u->rows_len);
-    if (!u->csv) {
-        fprintf(stderr, "murk: out of memory\n");
-        return 1;
-    }
-    fprintf(u->csv, "variant,label,budget,seed,spp,seconds,rays");
-    for (int k = 0; k < MURK_NCOUNTERS; k++)
-        fprintf(u->csv, ",%s", counter_names[k]);
-    fprintf(u->csv, ",mse,relmse,relmse_se,relmse_raw,ref_noise,mare,nonfinite,max_sample\n");
-    u->t0 = murk_now();
-    for (int i = 0; i < b->nbudgets; i++)
-        if (b->budgets[i] > b->budgets[u->big])
-            u->big = i;
-    u->total = b->nbudgets * b->repeat * b->nvariants;
-    u->np = (size_t)u->r.w * (size_t)u->r.h;
-    snprintf(title, sizeof title, "murk bench: %s", b->scene);
-    u->page = murk_html_new("bench", title, u->r.w, u->r.h, b->nvariants + 1, b->nvariants,
-                            murk_limit(MURK_LIMIT_PAGE_BYTES));
-    if (b->reference)
-        snprintf(title, sizeof title, "given: %s", b->reference);
-    else
-        snprintf(title, sizeof title, "%d spp, the mean of %d chunks",
-                 REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS), REF_CHUNKS);
-    murk_html_image(u->page, b->nvariants, "reference", title, u->r.rgb, 1);
-    u->pix = murk_xmalloc(u->np * sizeof(float));
-    u->maps = calloc(u->np * (size_t)b->nvariants, sizeof(double));
-    return u->maps ? 0 : 1;
-}
-
-/* A whole render's row, and at the largest budget its share of its variant's error map and of the page
- * (which shows the first seed's image). */
-static void record(run *u, int v, int bi, int k, const char *label, const murk_render_result *res)
-{
-    const bench *b = u->b;
-    const reference *r = &u->r;
-    murk_bench_row w = {.variant = v, .label = label, .budget = b->budgets[bi], .seed = 1 + k, .spp = res->spp,
-                   .seconds = res->seconds, .rays = res->rays, .counters = murk_counters_total(res),
-                   .max_sample = res->max_sample};
-    murk_metrics_compute(res->rgb, r->rgb, r->var, r->w, (murk_crop){0, 0, r->w, r->h}, &w.metrics, u->pix);
-    w.nonfinite = res->nonfinite + w.metrics.nonfinite;
-    csv_row(u->csv, &w);
-    if (b->row)
-        b->row(b->user, &w);
-    if (bi == u->big) {
-        for (size_t p = 0; p < u->np; p++)
-            u->maps[(size_t)v * u->np + p] += isfinite(u->pix[p]) ? u->pix[p] / b->repeat : 0.0;
-        murk_html_cost_add(u->page, v, res->seconds / b->repeat, (double)w.counters.lookups / b->repeat,
-                           w.metrics.relmse / b->repeat);
-        char note[96];
-        snprintf(note, sizeof note, "seed 1 of %d, %g %s", b->repeat, b->budgets[bi], b->time_mode ? "s" : "spp");
-        if (k == 0)
-            murk_html_image(u->page, v, label, note, res->rgb, 0);
-    }
-    u->done++;
-}
-
-/* Renders (or, --assemble, reads back) variant v at budget bi with seed 1 + k and records it unless a
- * signal abandoned it. 0, or 1 after a message. */
-static int render_one(run *u, int v, int bi, int k, const char *label, const char *const *sets, size_t n)
-{
-    const bench *b = u->b;
-    murk_render_opts o = {.threads = b->threads, .stop = b->stop};
-    if (b->time_mode) {
-        o.time_limit = b->budgets[bi];
-        o.spp = 1 << 24;
-    } else {
-        o.spp = (int)b->budgets[bi];
-    }
-    murk_render_result res;
-    int failed = bench_render(b, v, bi, k, sets, n, &o, u->r.w, u->r.h, &res);
-    if (failed == 0)
-        record(u, v, bi, k, label, &res);
-    free(res.rgb);
-    return failed < 0;
-}
-
-/* Every render: budgets outermost, then seeds, variants innermost (A B A B: a drift of the machine's speed
- * hits every variant alike), with a progress line on a terminal. 0, or 1 after a render failed; a signal
- * stops it after the running render. */
-static int sweep(run *u)
-{
-    const bench *b = u->b;
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
-    size_t nstore = 0;
-    double total_w = 0, done_w = 0;
-    for (int i = 0; i < b->nbudgets; i++)
-        total_w += b->budgets[i] * b->repeat * b->nvariants;
-    int rc = 0, count = 0, tty = murk_cli_progress();
-    for (int bi = 0; bi < b->nbudgets && !rc && !stopped(b); bi++)
-        for (int k = 0; k < b->repeat && !rc && !stopped(b); k++)
-            for (int v = 0; v < b->nvariants && !rc && !stopped(b); v++) {
-                char label[1024], eta[32] = "?";
-                variant_label(b, v, label, sizeof label);
-                if (done_w > 0)
-                    fmt_eta((murk_now() - u->t0) / done_w * (total_w - done_w), eta, sizeof eta);
-                count++;
-                if (tty) {
-                    fprintf(stderr, "\r\033[K[%d/%d] %s  %s %g  seed %d  ETA %s", count, u->total, label,
-                            b->time_mode ? "time" : "spp", b->budgets[bi], 1 + k, eta);
-                    fflush(stderr);
-                }
-                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                rc = render_one(u, v, bi, k, label, sets, n);
-                free_store(store, &nstore);
-                done_w += b->budgets[bi];
-                murk_warn_summary();
-            }
-    if (tty)
-        fprintf(stderr, "\r\033[K");
-    free(sets);
-    return rc;
-}
-
-/* The rows: bench.csv when every render was done; after a signal only the whole renders' rows, in
- * bench-interrupted.csv, never as bench.csv, and the stop status. rc: the sweep's. */
-static int write_rows(run *u, int rc)
-{
-    const bench *b = u->b;
-    char err[2048], path[8192];
-    int bad = fclose(u->csv) != 0;
-    text_job csv_text = {u->rows, u->rows_len};
-    if (rc == 0 && (bad || !u->rows)) {
-        fprintf(stderr, "murk: out of memory\n");
-        rc = 1;
-    }
-    if (rc == 0 && u->done < u->total) {
-        int cached = !b->reference && !u->r.reused && access(u->r.path, R_OK) == 0; /* rendered by this run */
-        snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
-        int kept = u->done > 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) == 0;
-        if (u->done > 0 && !kept)
-            fprintf(stderr, "murk: %s\n", err);
-        if (kept)
-            fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; their rows are in %s (the columns "
-                    "of bench.csv); no bench.csv, bench.json, maps or charts were written\n", murk_cli_stop_name(),
-                    u->done, u->total, murk_cli_q(path));
-        else
-            fprintf(stderr, "murk bench: interrupted (%s) after %d of %d renders; nothing written%s%s%s\n",
-                    murk_cli_stop_name(), u->done, u->total, cached ? " but the reference, cached in " : "",
-                    cached ? murk_cli_q(u->r.path) : "", cached ? " for the next bench" : "");
-        rc = murk_cli_stop_status();
-    }
-    snprintf(path, sizeof path, "%s/bench.csv", b->out);
-    if (rc == 0 && murk_write_atomic(path, text_fill, &csv_text, err, sizeof err) != 0) {
-        fprintf(stderr, "murk: %s\n", err);
-        rc = 1;
-    }
-    if (rc == 0) { /* a stale partial bench of an earlier run would sit beside the whole one */
-        snprintf(path, sizeof path, "%s/bench-interrupted.csv", b->out);
-        remove(path);
-    }
-    free(u->rows);
-    return rc;
-}
-
-/* The per-pixel error maps of the largest budget (maps/variantN.npy, and on the page) and bench.json. 0,
- * or 1 after a message. */
-static int write_maps(run *u, int argc, char **argv)
-{
-    const bench *b = u->b;
-    char err[2048], path[8192];
-    snprintf(path, sizeof path, "%s/maps", b->out);
-    if (mkdirs(path) != 0) {
-        fprintf(stderr, "murk: cannot create %s: %s\n", murk_cli_q(path), strerror(errno));
-        return 1;
-    }
-    for (int v = 0; v < b->nvariants; v++) {
-        for (size_t p = 0; p < u->np; p++)
-            u->pix[p] = (float)u->maps[(size_t)v * u->np + p];
-        murk_html_error_map(u->page, v, u->pix);
-        snprintf(path, sizeof path, "%s/maps/variant%d.npy", b->out, v);
-        npy_job nj = {u->pix, u->r.w, u->r.h};
-        if (murk_write_atomic(path, npy_fill, &nj, err, sizeof err) != 0) {
-            fprintf(stderr, "murk: %s\n", err);
-            return 1;
-        }
-    }
-    snprintf(path, sizeof path, "%s/bench.json", b->out);
-    meta_job mj = {b, &u->r, argc, argv};
-    if (murk_write_atomic(path, meta_fill, &mj, err, sizeof err) != 0) {
-        fprintf(stderr, "murk: %s\n", err);
-        return 1;
-    }
-    return 0;
-}
-
-/* The bench once its options are checked and its folder exists: the reference, every render, the files,
- * the charts and the page. The exit status. */
-static int run_bench(const bench *b, int argc, char **argv)
-{
-    char err[2048];
-    murk_scene *s0 = load_with(b, b->sets, b->nsets, err, sizeof err);
-    if (!s0) {
-        fprintf(stderr, "%s\n", err);
-        return 1;
-    }
-    run u = {.b = b, .r = {.w = s0->width, .h = s0->height}};
-    murk_scene_free(s0);
-    int rc = load_reference(b, &u.r);
-    if (rc != 0) {
-        ref_free(&u.r);
-        return rc;
-    }
-    fflush(stdout);
-    rc = run_open(&u);
-    if (u.csv) {
-        rc = rc ? rc : sweep(&u);
-        rc = write_rows(&u, rc);
-    }
-    if (rc == 0)
-        rc = write_maps(&u, argc, argv);
-    free(u.pix);
-    free(u.maps);
-    ref_free(&u.r);
-    if (rc == 0)
-        printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", u.total, b->nvariants,
-               b->nbudgets, b->repeat, murk_now() - u.t0, b->out);
-    int whole = rc == 0;
-    if (rc == 0)
-        rc = run_charts(b); /* and a signal after the last render is said there */
-    if (whole && rc <= 1 && !stopped(b))
-        rc = write_page(u.page, b, rc);
-    murk_html_free(u.page);
-    return rc;
-}
-
-/* One render as a command line of jobs.txt. */
-static void emit_job(const bench *b, FILE *jobs, const char *murk, const char *scene, const char *const *sets,
-                     size_t n, double budget, const char *out)
-{
-    char num[64], *line = NULL;
-    size_t len = 0;
-    FILE *f = open_memstream(&line, &len);
-    if (!f) {
-        fprintf(stderr, "murk: out of memory\n");
-        exit(1);
-    }
-    shell_word(f, murk);
-    fputs(" render", f);
-    shell_word(f, scene);
-    for (size_t i = 0; i < n; i++) {
-        fputs(" --set", f);
-        shell_word(f, sets[i]);
-    }
-    if (b->time_mode && budget > 0) {
-        snprintf(num, sizeof num, "%g", budget);
-        fprintf(f, " --time %s --spp %d", num, 1 << 24);
-    } else {
-        fprintf(f, " --spp %d", (int)budget);
-    }
-    if (b->threads)
-        fprintf(f, " --threads %d", b->threads);
-    fputs(" --quiet -o", f);
-    shell_word(f, out);
-    fclose(f);
-    fprintf(jobs, "%s\n", line + 1); /* without shell_word's leading space */
-    free(line);
-}
-
-/* jobs.txt: every render of the bench, the reference's chunks first, as one command line each that
- * writes its image where job_out says (b->jobs: the jobs' folder, absolute). The count. */
-static int jobs_txt(const bench *b, FILE *f, const char *murk, const char *scene)
-{
-    char out[8192];
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
-    size_t nstore = 0;
-    int njobs = 0;
-    for (int c = 0; c < REF_CHUNKS && !b->reference; c++) {
-        char seed[40];
-        size_t n = render_sets(b, -1, -1, sets, store, &nstore);
-        snprintf(seed, sizeof seed, "render.seed=%d", 900001 + c);
-        sets[n++] = seed;
-        job_out(b, -1, 0, c, out, sizeof out);
-        emit_job(b, f, murk, scene, sets, n, (b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS, out);
-        free_store(store, &nstore);
-        njobs++;
-    }
-    for (int bi = 0; bi < b->nbudgets; bi++)
-        for (int k = 0; k < b->repeat; k++)
-            for (int v = 0; v < b->nvariants; v++) {
-                size_t n = render_sets(b, v, 1 + k, sets, store, &nstore);
-                job_out(b, v, bi, k, out, sizeof out);
-                emit_job(b, f, murk, scene, sets, n, b->budgets[bi], out);
-                free_store(store, &nstore);
-                njobs++;
-            }
-    free(sets);
-    return njobs;
-}
-
-/* assemble.sh: the bench's own command line, in its folder, with --assemble DIR for --emit-jobs DIR. */
-static void assemble_sh(FILE *f, const char *murk, const char *dir, int argc, char **argv)
-{
-    char cwd[4096];
-    fprintf(f, "#!/bin/sh\n# Reads the renders of jobs.txt back into bench.csv, the charts and the report: the\n"
-               "# bench's own command line, in its folder, with --assemble for --emit-jobs.\ncd");
-    shell_word(f, getcwd(cwd, sizeof cwd) ? cwd : ".");
-    fputs(" || exit 1\nexec", f);
-    shell_word(f, murk);
-    fputs(" bench", f);
-    for (int i = 0; i < argc; i++) {
-        if (!strcmp(argv[i], "--emit-jobs")) {
-            fputs(" --assemble", f);
-            shell_word(f, dir);
-            i++;
-        } else {
-            shell_word(f, argv[i]);
-        }
-    }
-    fputc('\n', f);
-}
-
-/* --emit-jobs DIR: every render of the bench (the reference's chunks first) as one line of DIR/jobs.txt,
- * DIR/slurm.sh running line SLURM_ARRAY_TASK_ID + 1 as one task of a job array, and DIR/assemble.sh,
- * this bench's command line with --assemble DIR, which reads the images back into bench.csv, the
- * charts and the report as if the renders had run here. The jobs' paths are absolute. */
-static int emit_jobs(const bench *b, int argc, char **argv)
-{
-    char murk[4096], scene[4096], dir[4096], path[8192];
-    ssize_t l = readlink("/proc/self/exe", murk, sizeof murk - 1);
-    if (l <= 0 || !realpath(b->scene, scene)) {
-        fprintf(stderr, "murk: cannot resolve the paths of murk and %s\n", murk_cli_q(b->scene));
-        return 1;
-    }
-    murk[l] = 0;
-    snprintf(path, sizeof path, "%s/renders", b->jobs);
-    if (mkdirs(path) != 0 || !realpath(b->jobs, dir)) {
-        fprintf(stderr, "murk: cannot create %s: %s\n", murk_cli_q(path), strerror(errno));
-        return 1;
-    }
-    bench jb = *b;
-    jb.jobs = dir;
-    /* the three files as text in memory, then written as one group (atomic.h): all of them or none */
-    enum { JOBS, SLURM, ASSEMBLE, NFILES };
-    static const char *const names[NFILES] = {"jobs.txt", "slurm.sh", "assemble.sh"};
-    char *text[NFILES] = {NULL, NULL, NULL};
-    size_t len[NFILES] = {0, 0, 0};
-    int njobs = 0, bad = 0;
-    for (int i = 0; i < NFILES && !bad; i++) {
-        FILE *f = open_memstream(&text[i], &len[i]);
-        if (!f) {
-            bad = 1;
-            break;
-        }
-        if (i == JOBS)
-            njobs = jobs_txt(&jb, f, murk, scene);
-        else if (i == SLURM)
-            fprintf(f, "#!/bin/sh\n# murk bench as a Slurm job array: one render per task (line TASK + 1 of jobs.txt).\n"
-                       "#   jid=$(sbatch --parsable slurm.sh)\n"
-                       "#   sbatch --dependency=afterok:$jid --wrap 'sh %s/assemble.sh'\n"
-                       "#SBATCH --job-name=murk-bench\n#SBATCH --array=0-%d\n"
-                       "exec sh -c \"$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" '%s/jobs.txt')\"\n", dir, njobs - 1,
-                    dir);
-        else
-            assemble_sh(f, murk, dir, argc, argv);
-        bad = fclose(f) != 0;
-    }
-    char err[8400] = "out of memory";
-    if (!bad) {
-        murk_output_begin();
-        for (int i = 0; i < NFILES && !bad; i++) {
-            text_job tj = {text[i], len[i]};
-            snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-            bad = murk_write_atomic(path, text_fill, &tj, err, sizeof err) != 0;
-        }
-        if (bad)
-            murk_output_abort();
-        else
-            bad = murk_output_commit(err, sizeof err) != 0;
-    }
-    for (int i = 0; i < NFILES; i++)
-        free(text[i]);
-    if (bad) {
-        fprintf(stderr, "murk: %s\n", err);
-        return 1;
-    }
-    printf("%d renders as jobs: %s/jobs.txt (one command a line), %s/slurm.sh (sbatch: a job array); then "
-           "sh %s/assemble.sh\n", njobs, dir, dir, dir);
-    return 0;
 }
 
 static const char bench_usage[] =
@@ -1408,14 +446,14 @@ static int bench_main(bench *b, int argc, char **argv)
     if (validate(b) != 0)
         return 1;
     if (b->jobs && !b->assemble) {
-        int rc = emit_jobs(b, argc, argv);
+        int rc = murk_bench_emit_jobs(b, argc, argv);
         return rc ? rc : -1;
     }
     struct stat st;
     int made_out = stat(b->out, &st) != 0;
     if (b->command)
-        b->stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
-    if (mkdirs(b->out) != 0) {
+        b->stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (murk_bench_run) */
+    if (murk_bench_mkdirs(b->out) != 0) {
         fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b->out), strerror(errno));
         return 1;
     }
@@ -1425,7 +463,7 @@ static int bench_main(bench *b, int argc, char **argv)
         fprintf(stderr, "murk: %s; nothing was rendered\n", err);
         return 1;
     }
-    int rc = run_bench(b, argc, argv);
+    int rc = murk_bench_run(b, argc, argv);
     if (rc > 128 && made_out)
         rmdir(b->out); /* interrupted: the folder it made goes again if nothing was written into it */
     return rc;
