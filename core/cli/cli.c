@@ -7,7 +7,6 @@
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "check/check.h"
 #include "cli/cli.h"
 #include "image/image.h"
 #include "load/load.h"
@@ -21,6 +20,7 @@
 #include "util/limit.h"
 #include "util/runtime.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <errno.h>
 #include <math.h>
@@ -107,7 +107,7 @@ static int command_usage(const char *cmd)
     for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
         if (!strcmp(command_help[i].name, cmd)) {
             if (!command_help[i].text)
-                return murk_cli_bench(1, (char *[]){"--help", NULL});
+                return murk_lab_bench(1, (char *[]){"--help", NULL});
             fputs(command_help[i].text, stdout);
             return 0;
         }
@@ -723,11 +723,11 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "plugins"))
         return murk_cli_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
-        return murk_cli_compare(argc - 2, argv + 2);
+        return murk_lab_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench"))
-        return murk_cli_bench(argc - 2, argv + 2);
+        return murk_lab_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "check"))
-        return murk_check_main(argc - 1, argv + 1);
+        return murk_lab_check(argc - 2, argv + 2);
     if (!strcmp(cmd, "grid"))
         return cmd_grid(argc - 2, argv + 2);
     if (!strcmp(cmd, "merge"))
