@@ -35,9 +35,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host.h"
+#include "render/host.h"
 #include "pathtracer.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 #define NEE_RES 32
 #define NEE_BLOCK 8

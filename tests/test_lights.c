@@ -15,8 +15,8 @@
  * block-wise z. */
 #include "testutil.h"
 #include "stat.h"
-#include "host.h"
-#include "scene.h"
+#include "render/host.h"
+#include "scene/scene.h"
 
 #include "murk/math.h"
 

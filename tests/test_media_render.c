@@ -23,8 +23,8 @@
  * errors of the expectation (stat.h); each has a must-fail case: the same image against an expectation
  * 3 % lower (what a 3 % energy loss or gain would render), which it must fail. */
 #include "testutil.h"
-#include "image.h"
 #include "stat.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdarg.h>

@@ -3,7 +3,7 @@
  * metadata read back through OpenEXRCore). */
 #include "testutil.h"
 #include "stat.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -7,9 +7,9 @@
  * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
 #include "testutil.h"
 #include "stat.h"
-#include "host.h"
-#include "image.h"
-#include "scene.h"
+#include "render/host.h"
+#include "image/image.h"
+#include "scene/scene.h"
 
 #include "murk/math.h"
 

@@ -4,7 +4,7 @@
  * Also: in-process parsing errors, and a rendered GGX furnace that must not exceed 1 beyond noise. */
 #include "testutil.h"
 #include "stat.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdio.h>

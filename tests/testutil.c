@@ -1,8 +1,8 @@
 /* testutil.c — see testutil.h */
 #include "testutil.h"
 #include "stat.h"
-#include "image.h"
-#include "sphere.h"
+#include "image/image.h"
+#include "lab/check/sphere.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -143,7 +143,7 @@ int run_murk_argv(char **out, const char *const *args) { return run_captured(out
 
 int run_murk_split(char **out, char **err, const char *const *args) { return run_captured(out, err, args); }
 
-/* The same chi-square test as `murk check` (core/check/sphere.c). */
+/* The same chi-square test as `murk check` (core/lab/check/sphere.c). */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out)
 {
     return murk_chi2_test(observed, expected, nbins, min_expected, dof_out);

@@ -30,7 +30,7 @@
 #ifndef MURK_DENSITY_H
 #define MURK_DENSITY_H
 
-#include "limit.h"
+#include "util/limit.h"
 #include <stddef.h>
 #include <stdint.h>
 

@@ -2,9 +2,9 @@
  * memory, evaluated trilinearly, and queried. See density.h for the conventions (values at cell centres,
  * trilinear, clamp, 0 outside). The grid sources are in vol.c, nanovdb.c and cloud.c; the majorant grid
  * over a field in majorant.c, its DDA walk in dda.c. */
-#include "field_impl.h"
-#include "error.h"
-#include "util.h"
+#include "media/field_impl.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -105,7 +105,7 @@ murk_field *murk_field_adopt(const char *path, const int res[3], const int origi
     return f;
 }
 
-murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi, const float *data)
+MURK_API murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi, const float *data)
 {
     uint64_t n = murk_voxel_count(res[0], res[1], res[2]);
     if (n == 0 || !murk_box_ok(lo, hi))

@@ -1,6 +1,6 @@
 /* majorant.c — the bound grid over a density field: per cell a majorant and a minorant of the field
  * (see density.h for the guarantee). Trackers walk it with the DDA in dda.c. */
-#include "field_impl.h"
+#include "media/field_impl.h"
 
 #include <math.h>
 #include <stdlib.h>

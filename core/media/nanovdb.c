@@ -5,9 +5,9 @@
  * bytes each, = gridSize when uncompressed) — or, since NanoVDB 32.6, raw grid buffers back to back.
  * Each grid buffer is read with PNanoVDB (the C port of NanoVDB), bounds-checked, so a corrupt file
  * yields zeros or an error rather than a wild read. */
-#include "field_impl.h"
-#include "error.h"
-#include "file.h"
+#include "media/field_impl.h"
+#include "util/error.h"
+#include "util/file.h"
 
 #include <math.h>
 #include <stdint.h>

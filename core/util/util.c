@@ -1,13 +1,11 @@
 /* util.c — small helpers internal to libmurk. */
-#include "util.h"
+#include "util/util.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-static int quiet;
 
 MURK_API void *murk_xmalloc(size_t n)
 {
@@ -100,14 +98,12 @@ char *murk_path_relative_to(const char *path, const char *rel)
     return out;
 }
 
-double murk_now(void)
+MURK_API double murk_now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
-
-MURK_API void murk_set_quiet(int q) { quiet = q; }
 
 /* Length of the valid UTF-8 sequence at s (2..4), or 0 if there is none. */
 static size_t utf8_len(const unsigned char *s)
@@ -168,16 +164,4 @@ MURK_API char *murk_printable(char *dst, size_t n, const char *src)
     }
     dst[k] = 0;
     return dst;
-}
-
-MURK_API void murk_log(int level, const char *fmt, ...)
-{
-    if (quiet && level == MURK_LOG_INFO)
-        return;
-    char raw[2048], safe[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(raw, sizeof raw, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "%s%s\n", level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", murk_printable(safe, sizeof safe, raw));
 }
