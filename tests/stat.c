@@ -96,7 +96,7 @@ int stat_must_fail(const char *label, int failed, double z)
     beta_sum += failed ? beta : 1.0;
     int judged = stat_power();
     printf("  must-fail %-60s %s (bias %.1f se; passes by chance with p %.1e)%s\n", label,
-           failed ? "failed, as it must" : "PASSED", k, beta, failed || !judged ? "" : "  <-- FAIL");
+           failed ? "failed, as it must" : "PASSED", fmin(k, 9999.0), beta, failed || !judged ? "" : "  <-- FAIL");
     return failed || !judged;
 }
 
