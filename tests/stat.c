@@ -81,6 +81,19 @@ double stat_z2(double a, double se_a, double b, double se_b)
     return a == b ? 0.0 : INFINITY;
 }
 
+int stat_count_check(const char *out)
+{
+    const char *at = out ? strstr(out, "murk check: ") : NULL;
+    int passed = 0, failed = -1, skipped = 0;
+    long n = 0;
+    double alpha = 0.0;
+    if (!at || sscanf(at, "murk check: %d passed, %d failed, %d skipped; %ld statistical decisions, false-alarm bound %lg",
+                      &passed, &failed, &skipped, &n, &alpha) != 5)
+        fail_msg("no summary line in murk check's output:\n%s", out ? out : "(null)");
+    stat_count(n, n > 0 ? alpha / (double)n : 0.0);
+    return failed;
+}
+
 int stat_chi2_ok(double p)
 {
     stat_count(1, STAT_P);

@@ -52,6 +52,10 @@ double stat_z2(double a, double se_a, double b, double se_b);
  * term. stat_bounded_ok: |est - expect| within it plus slack, counted as one decision. */
 double stat_eb_bound(double var, long n, double range);
 int stat_bounded_ok(double est, double var, long n, double expect, double range, double slack);
+/* Counts the decisions of `murk check`'s summary line in its output out ("N statistical decisions,
+ * false-alarm bound A": murk check decides by the same rule) and returns its failed checks; fails the
+ * test if out holds no summary line. Only for runs that must pass: a must-fail run is not a decision. */
+int stat_count_check(const char *out);
 /* The chi-square decision: 1 if p >= STAT_P. Counts one decision. */
 int stat_chi2_ok(double p);
 

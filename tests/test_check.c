@@ -1,4 +1,4 @@
-/* test_check.c — `murk check` (core/check/check.c) in the default suite.
+/* test_check.c — `murk check` (core/lab/check/check.c) in the default suite.
  *
  *   shipped    `murk check --quick` on every plugin the build made (the .so files in build/plugins: materials,
  *              trackers, transmittance estimators, integrators) passes. Its statistical decisions (the
@@ -15,20 +15,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Counts the decisions of murk check's summary line in out (stat.h's sums); returns the failed checks. */
-static int summary(const char *out)
-{
-    const char *at = strstr(out, "murk check: ");
-    int passed = 0, failed = -1, skipped = 0;
-    long n = 0;
-    double alpha = 0.0;
-    if (!at || sscanf(at, "murk check: %d passed, %d failed, %d skipped; %ld statistical decisions, false-alarm bound %lg",
-                      &passed, &failed, &skipped, &n, &alpha) != 5)
-        fail_msg("no summary line in murk check's output:\n%s", out);
-    stat_count(n, n > 0 ? alpha / (double)n : 0.0);
-    return failed;
-}
 
 static int cmp_str(const void *a, const void *b) { return strcmp(*(char *const *)a, *(char *const *)b); }
 
@@ -53,7 +39,7 @@ static void test_shipped(void **state)
     args[2 + n] = NULL;
     char *out = NULL;
     int rc = run_murk_argv(&out, args);
-    int failed = summary(out);
+    int failed = stat_count_check(out);
     printf("murk check --quick on %d plugins: exit %d, %d failed\n%s\n", n, rc, failed,
            rc || failed ? out : strstr(out, "murk check: "));
     assert_int_equal(rc, 0);

@@ -332,12 +332,14 @@ static void test_check_transmission(void **state)
     int rc = run_murk(&out, "check", "--quick", "dielectric", NULL);
     fprintf(stderr, "%s", out);
     assert_int_equal(rc, 0);
+    assert_int_equal(stat_count_check(out), 0);
     assert_contains(out, "dielectric: all checks passed");
     assert_contains(out, "PASS chi2        set 1, wo 80 deg inside");
     assert_contains(out, "PASS reciprocity set 2                        transmission f(a,b)/eta_a^2 = f(b,a)/eta_b^2");
     free(out);
     rc = run_murk(&out, "check", "--quick", build_path("tests/fixtures/frosted_ok.so"), NULL);
     assert_int_equal(rc, 0);
+    assert_int_equal(stat_count_check(out), 0);
     assert_contains(out, "frosted_ok: all checks passed");
     free(out);
     rc = run_murk(&out, "check", "--quick", build_path("tests/fixtures/bad_frosted_sampling.so"), NULL);
