@@ -10,11 +10,11 @@
  *            25% / 75%, RGB channels spread apart), at wo = 10, 45 and 80 degrees:
  *              chi2       sample() against pdf(): the sphere cut into 16 x 32 cells refined around the
  *                         mirror direction, expected counts from adaptive quadrature of pdf() over each
- *                         cell, one more cell for "no sample or a delta lobe"; fails below p = 1e-4.
+ *                         cell, one more cell for "no sample or a delta lobe"; fails below p = CK_P (1e-6).
  *                         Also fails if sample()'s f / pdf disagree with eval() / pdf() (relative 1e-3)
  *                         for more than 1e-4 of the samples, or pdf() integrates to more than 1.
  *              furnace    the directional albedo E(wo) = mean of f |cos| / pdf must not exceed 1 by
- *                         more than 4 standard errors (energy conservation).
+ *                         more than CK_Z (5) standard errors (energy conservation).
  *              reciprocity f(wo, wi) = f(wi, wo) for 4096 random pairs above the surface (relative 1e-3).
  *            A material that transmits (some sample with wi.z < 0 at 45 degrees from either side) also gets:
  *              eta        the indices s->eta reports (at most 3, those from inside the inverses of those
@@ -33,9 +33,9 @@
  *              pass       mean of sample()'s weight / mean(pdf_ratio) on pass-through = exp(-sigma_t D)
  *              scatter    the same on scattering events      = (sigma_s / sigma_t)(1 - exp(-sigma_t D))
  *              bin k      (slab) scattering events in each quarter of the segment, closed form
- *            each within 4 standard errors (from the sample variance) of the closed form; then the
+ *            each within CK_Z (5) standard errors (from the sample variance) of the closed form; then the
  *            cross-tracker invariance z-test: every figure against the built-in `delta` tracker on the
- *            same ray, |difference| <= 4 combined standard errors. A tracker may refuse chromatic media
+ *            same ray, |difference| <= CK_Z combined standard errors. A tracker may refuse chromatic media
  *            in create() (reported, not a failure); grey media it must take.
  * transmittance (an estimator) under the built-in `delta` tracker, through murk_medium_transmittance() as a
  *            shadow ray takes it, on the slab and the checker above and a linear ramp (4 x 4 x 16 voxels
@@ -49,7 +49,7 @@
  *            has its T figures printed and not judged (SKIP).
  * integrator escaped camera rays return the background (an empty scene, exactly), and a furnace: the
  *            camera inside a closed box of inward-facing quads with albedo 0.5 and emission 0.5, where
- *            the radiance is 0.5 / (1 - 0.5) = 1 everywhere; the image mean must be 1 within 4 standard
+ *            the radiance is 0.5 / (1 - 0.5) = 1 everywhere; the image mean must be 1 within CK_Z standard
  *            errors (from the pixel variance). The same box filled with a non-absorbing medium (tracker
  *            `delta`) must still give 1, whether the integrator handles media or ignores them.
  *
