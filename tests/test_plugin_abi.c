@@ -78,8 +78,8 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case bad_cases[] = {
-    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.6"},
-    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.7, this murk has ABI 1.6"},
+    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.7"},
+    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.8, this murk has ABI 1.7"},
     {"no_entry", MURK_KIND_MATERIAL, "no 'murk_plugin_entry' function"},
     {"no_abi", MURK_KIND_MATERIAL, "no 'murk_plugin_abi' symbol: not a murk plugin"},
     {"bad_size", MURK_KIND_MATERIAL, "descriptor struct_size is"},
@@ -121,7 +121,7 @@ static void test_open_bad_details(void **state)
     murk_plugin p;
     char want[256];
     assert_int_equal(murk_plugin_open(fixture("bad_size"), 0, &p, err, sizeof err), -1);
-    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.6",
+    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.7",
              MURK_PLUGIN_DESC_SIZE_1_0 - sizeof(void *), MURK_PLUGIN_DESC_SIZE_1_0);
     assert_contains(err, want);
 
@@ -181,7 +181,7 @@ static void test_open_not_a_library(void **state)
     /* another major ABI with an aborting constructor: refused from the symbol table, never loaded */
     const char *ctor = fixture("abi_ctor");
     assert_int_equal(murk_plugin_open(ctor, 0, &p, err, sizeof err), -1);
-    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.6");
+    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.7");
     assert_null(strchr(err, '\n'));
 }
 
@@ -541,7 +541,7 @@ static void test_cli_render_fixtures(void **state)
     const char *plugins = murk_image_meta(&img, "murk:plugins");
     assert_non_null(plugins);
     char rec[1300];
-    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1.6)", fixture("good_fixture"));
+    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1.7)", fixture("good_fixture"));
     assert_contains(plugins, rec);
     assert_contains(plugins, "path=");
     murk_image_free(&img);
@@ -642,7 +642,7 @@ static void test_cli_plugins(void **state)
     free(out);
     st = run_murk(&out, "plugins", "abi_major", NULL);
     assert_int_equal(st, 1);
-    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.6");
+    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.7");
     assert_contains(out, fixture("abi_major"));
     free(out);
     st = run_murk(&out, "plugins", "good_fixture", NULL);

@@ -26,7 +26,10 @@
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
  * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h);
- * 1.6 appends murk_host.boundaries.
+ * 1.6 appends murk_host.boundaries; 1.7 adds the phase-function kind (murk/phase.h), murk_host's
+ * medium_phase_eval / medium_phase_sample / albedo / emission, murk_medium_data's fields and
+ * integrator_minor, murk_medium_event's emitted and null_prob, murk_path_ctx's pdf_ratio and flags
+ * (murk/medium.h: albedo and emission fields, volume emission).
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -58,7 +61,7 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 6
+#define MURK_ABI_MINOR 7
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
