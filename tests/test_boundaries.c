@@ -126,7 +126,7 @@ static void test_shadow(void **state)
                 for (int i = 0; i < N; i++) {
                     murk_rng rng;
                     murk_rng_seed(&rng, 77, c, (uint64_t)i);
-                    murk_path_ctx ctx = {i % 3, murk_rgb1(1.0f)};
+                    murk_path_ctx ctx = {.hero = i % 3, .beta = murk_rgb1(1.0f)};
                     murk_rgb T = murk_pt_shadow(&pt, s, p, n, q, sc->inside ? med : NULL, &ctx, &rng);
                     for (int k = 0; k < 3; k++) {
                         s1[k] += T.c[k];

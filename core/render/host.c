@@ -227,6 +227,10 @@ static const murk_host host_table = {
     .sample_light_with = murk_lights_sample,
     .light_pdf_with = murk_lights_pdf,
     .boundaries = host_boundaries,
+    .medium_phase_eval = murk_media_phase_eval,
+    .medium_phase_sample = murk_media_phase_sample,
+    .albedo = murk_media_albedo,
+    .emission = murk_media_emission,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }

@@ -261,7 +261,7 @@ typedef struct vertex {
     const murk_material *mat;
     const murk_hit *hit;
     murk_vec3 t, b, n, wo_local;
-    float g;
+    const murk_medium *medium; /* the medium whose phase function scatters (mat == NULL) */
     const murk_medium *behind; /* the medium on the far side of the surface from wo */
 } vertex;
 
@@ -278,7 +278,7 @@ static int vertex_side_ok(const vertex *v, murk_vec3 wi, murk_vec3 wl)
 static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
-        return murk_rgb1(h->phase_eval(v->g, v->wo, wi));
+        return murk_rgb1(h->medium_phase_eval(v->medium, v->wo, wi));
     murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
     if (!vertex_side_ok(v, wi, wl))
         return murk_rgb1(0.0f);
@@ -289,7 +289,7 @@ static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
 static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
-        return h->phase_eval(v->g, v->wo, wi);
+        return h->medium_phase_eval(v->medium, v->wo, wi);
     return v->mat->vt->pdf(v->mat->self, v->hit, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
 }
 
@@ -447,7 +447,7 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     vertex v = {0};
     v.p = x;
     v.wo = murk_neg(st->ray.d);
-    v.g = m->data->g;
+    v.medium = m;
     path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
     at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
     at.L = murk_rgb1(0.0f);
@@ -469,13 +469,18 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     murk_ray seg = st->ray;
     seg.tmax = tmax;
     murk_medium_event ev;
+    ev.emitted = murk_rgb1(0.0f); /* a tracker adds an emitting medium's radiance (murk/medium.h) */
+    ev.null_prob = -1.0f;
     st->ctx.beta = st->beta;
+    st->ctx.pdf_ratio = st->R;
     murk_sample_seek(rng, PT_SLOT_FLIGHT(st->depth, st->crossings));
     m->vt->sample(m->self, &seg, &st->ctx, rng, &ev);
-    if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t))) {
+    if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t)) || !finite3(ev.emitted)) {
         broken(h, "medium", m->name, "free-flight weight");
         return PT_END;
     }
+    if (!murk_rgb_is_black(ev.emitted)) /* credited with beta and R before the flight */
+        add_light(st, ev.emitted, 1.0f, MURK_PT_TERM_MEDIUM_EMISSION);
     st->beta = murk_rgb_mul(st->beta, ev.weight);
     st->R = murk_rgb_mul(st->R, ev.pdf_ratio);
     if (murk_rgb_is_black(st->beta) || !(mean3(st->R) > 0.0f))
@@ -487,17 +492,23 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     vertex v = {0};
     v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
     v.wo = murk_neg(st->ray.d);
-    v.g = m->data->g;
+    v.medium = m;
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
         sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t),
                      MURK_PT_TERM_MEDIUM_NEE, rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
-    murk_vec3 wi = h->phase_sample(v.g, v.wo, u, &pdf);
+    murk_vec3 wi;
+    float p = h->medium_phase_sample(m, v.wo, u, &wi, &pdf);
     if (!(pdf > 0.0f))
         return PT_END;
-    /* HG is sampled exactly: phase / pdf = 1, beta stays */
+    if (!isfinite(p) || !isfinite(wi.x + wi.y + wi.z)) {
+        broken(h, "phase function of medium", m->name, "sample");
+        return PT_END;
+    }
+    if (p != pdf) /* murk's phase functions sample exactly (p / pdf = 1): beta stays */
+        st->beta = murk_rgb_scale(st->beta, p / pdf);
     st->prev_p = v.p;
     st->prev_pdf = pdf;
     st->prev_delta = 0;

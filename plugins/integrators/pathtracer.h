@@ -71,11 +71,13 @@ murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p,
 
 /* The techniques the path tracer tells apart, one for each contribution it makes to a sample (its
  * `term`): light sampling at a surface vertex, at a free-flight medium vertex and at the equiangular
- * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background.
+ * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background;
+ * emission of a medium, collected along free flights.
  * And how a path ended. Only a build with the tap (-DMURK_PT_TAP, pathtracer_tap.h: bench/variance_profile,
  * never the plugins) reports them. */
 enum { MURK_PT_TERM_SURFACE_NEE, MURK_PT_TERM_MEDIUM_NEE, MURK_PT_TERM_EQUIANGULAR_NEE, MURK_PT_TERM_BSDF_EMISSION,
-       MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_NTERMS };
+       MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_TERM_MEDIUM_EMISSION,
+       MURK_PT_NTERMS };
 enum { MURK_PT_END_ROULETTE, MURK_PT_END_MAX_DEPTH, MURK_PT_END_ABSORBED, MURK_PT_END_ESCAPED, MURK_PT_NENDS };
 
 #endif

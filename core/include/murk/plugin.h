@@ -82,7 +82,8 @@ typedef enum murk_kind {
     MURK_KIND_MATERIAL = 1,
     MURK_KIND_MEDIUM = 2,
     MURK_KIND_INTEGRATOR = 3,
-    MURK_KIND_TRANSMITTANCE = 4 /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
+    MURK_KIND_TRANSMITTANCE = 4, /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
+    MURK_KIND_PHASE = 5          /* ABI 1.7: phase functions (murk/phase.h) */
 } murk_kind;
 
 /* ---- Parameter schema ---------------------------------------------------------------------- */
@@ -194,6 +195,17 @@ typedef struct murk_host {
      * every surface occluded() can find has a material: a shadow ray it reports blocked is blocked,
      * with no intersect() to tell a boundary from an occluder. */
     size_t (*boundaries)(const murk_scene *scene);
+    /* ABI 1.7: medium m's phase function (its `phase:` block, else Henyey-Greenstein of its g;
+     * murk/phase.h). medium_phase_eval is p(wo, wi) and the pdf of medium_phase_sample, which draws wi
+     * from the uniforms u, sets *pdf and returns the value p(wo, wi) (0: no sample). */
+    float (*medium_phase_eval)(const murk_medium *m, murk_vec3 wo, murk_vec3 wi);
+    float (*medium_phase_sample)(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf);
+    /* ABI 1.7: a medium's fields beside its density at a world point (murk/medium.h: which a medium has is
+     * murk_medium_data.fields): the single-scattering albedo per channel, and the radiance Le emitted per
+     * unit absorption (the medium emits sigma_a(p) Le(p) per unit length). Each is one lookup, counted
+     * like a density lookup. */
+    murk_rgb (*albedo)(const murk_density *d, murk_vec3 p);
+    murk_rgb (*emission)(const murk_density *d, murk_vec3 p);
 } murk_host;
 
 /* Light sampling strategies (ABI 1.4). AREA: a triangle uniformly by area (a rectangular quad or box

@@ -28,6 +28,7 @@ typedef struct murk_tracker {
     float smax;       /* its largest channel */
     int grey;         /* 1 if sigma_t is the same in every channel */
     const char *plugin; /* the tracker's name for the watchdog's reports; set it after murk_tracker_new */
+    uint32_t fields;  /* the medium's fields beside density (MURK_FIELD_*, murk/medium.h; 0 before ABI 1.7) */
 } murk_tracker;
 
 /* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
@@ -49,6 +50,7 @@ static inline void *murk_tracker_new(const murk_host *host, const murk_medium_da
     t->sigma_t = murk_rgb_add(d->sigma_a, d->sigma_s);
     t->smax = murk_rgb_max(t->sigma_t);
     t->grey = t->sigma_t.c[0] == t->sigma_t.c[1] && t->sigma_t.c[1] == t->sigma_t.c[2];
+    t->fields = MURK_HAS(d->size, murk_medium_data, integrator_minor) ? d->fields : 0;
     return t;
 }
 
@@ -309,6 +311,80 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
  * absorbed or scattered): at the first collision of a stratified flight with sobol the slot's second
  * coordinate, else the PCG stream's. Draw it with this, not murk_rng_float. */
 static inline float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
+
+/* ---- Fields beside density (ABI 1.7; murk/medium.h) ---------------------------------------------------
+ * A medium with an albedo field or emission (t->fields != 0) needs more per collision than one without, so
+ * murk's trackers write their collision loop once as a MURK_ALWAYS_INLINE function with a constant flag
+ * and call it twice: the instance without fields is the loop as it always was (no lookups, no branches
+ * added per collision), chosen once per flight.
+ *
+ * Albedo: at a collision at p with density dens, murk_local_sigma gives the local sigma_a,k(p) and
+ * sigma_s,k(p) (with an albedo field a(p): a sigma_t,k dens and (1 - a) sigma_t,k dens); use them
+ * wherever the constants d->sigma_a, d->sigma_s times dens would be (scattering weights, spectral
+ * tracking's probabilities). Extinction, and so the majorants and null collisions, do not change.
+ *
+ * Emission: the collision estimator of pbrt-v4 (VolPathIntegrator): at EVERY tentative collision of the
+ * flight at p — null or real, before its choice — add  w_k sigma_a,k(p) Le_k(p) / mu  to the flight's
+ * emitted radiance, w the flight's running weight per channel and mu the rate the collision was drawn
+ * with. Tentative collisions are a Poisson process of rate mu, and a collision at t is reached with
+ * probability density mu(t) times the null-collision weights so far, whose expectation per channel is
+ * the transmittance T_k(t) (the running weights reweight every channel to its own); so the sum has
+ * expectation int T_k(t) sigma_a,k Le_k dt per channel, chromatic extinction included: unbiased, and it
+ * needs no probability of its own. (Scoring at real collisions only, weighted by sigma_a / sigma_t, is
+ * unbiased too, but in a thin flame real collisions are rare, while every null collision scores here.)
+ * Decomposition tracking's two processes together are one of rate control + residual; spectral MIS
+ * credits each score with the pdf ratios the path has at that collision (murk_emit's r). */
+#if defined(__GNUC__)
+#define MURK_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define MURK_ALWAYS_INLINE inline
+#endif
+
+/* 1 if the flight must collect emission: the medium emits and the integrator passes events that hold it. */
+static inline int murk_emitting(const murk_tracker *t)
+{
+    return (t->fields & MURK_FIELD_EMISSION) && t->d->integrator_minor >= 7;
+}
+
+/* a / b, 0 where b is 0 (a local albedo where the density vanishes). */
+static inline float murk_ratio0(float a, float b) { return b > 0.0f ? a / b : 0.0f; }
+
+/* The local absorption and scattering coefficients at p, density dens (see above). */
+static inline void murk_local_sigma(const murk_tracker *t, murk_vec3 p, float dens, float sa[3], float ss[3])
+{
+    if (t->fields & MURK_FIELD_ALBEDO) {
+        murk_rgb a = t->host->albedo(t->d->density, p);
+        for (int k = 0; k < 3; k++) {
+            float st = dens * t->sigma_t.c[k];
+            ss[k] = a.c[k] * st;
+            sa[k] = (1.0f - a.c[k]) * st;
+        }
+    } else {
+        for (int k = 0; k < 3; k++) {
+            sa[k] = dens * t->d->sigma_a.c[k];
+            ss[k] = dens * t->d->sigma_s.c[k];
+        }
+    }
+}
+
+/* The emission score of a tentative collision at p (see above): ev->emitted += w sa Le / mu, times
+ * mean(R) / mean(R r) with R the path's pdf ratios before the flight (ctx) and r the flight's pdf ratios up
+ * to this collision (ev->pdf_ratio for a tracker that keeps them there; 1 for trackers without per-channel
+ * techniques), so that the integrator's crediting (beta emitted / mean(R)) weights each score as spectral
+ * MIS weights a path ending there. */
+static inline void murk_emit(const murk_tracker *t, const murk_path_ctx *ctx, murk_medium_event *ev, murk_vec3 p,
+                             const float sa[3], float mu, murk_rgb w, murk_rgb r)
+{
+    murk_rgb le = t->host->emission(t->d->density, p);
+    float f = 1.0f / mu;
+    if (r.c[0] != 1.0f || r.c[1] != 1.0f || r.c[2] != 1.0f) {
+        murk_rgb R = ctx->pdf_ratio;
+        float m = R.c[0] + R.c[1] + R.c[2], mr = R.c[0] * r.c[0] + R.c[1] * r.c[1] + R.c[2] * r.c[2];
+        f = mr > 0.0f ? f * m / mr : 0.0f;
+    }
+    for (int k = 0; k < 3; k++)
+        ev->emitted.c[k] += w.c[k] * sa[k] * le.c[k] * f;
+}
 
 /* Ratio tracking (Novak et al. 2014) over (ray->tmin, ray->tmax) with majorant segments from the
  * walk; extra: a second density-proportional extinction that is handled in closed form instead
