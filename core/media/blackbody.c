@@ -13,6 +13,7 @@
  * 830 nm (CIE 015:2018, Table 1), with the digits of the table as Debian's colord-data 1.4.6 ships it
  * (/usr/share/colord/cmf/CIE1931-2deg-XYZ.cmf). */
 #include "media/density.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -52,7 +53,13 @@ static const double cie1931_5nm[95][3] = {
     {0.000001776509, 0.00000064153, 0.0}, {0.000001251141, 0.00000045181, 0.0},
 };
 
-void murk_blackbody_xyz(double T, double xyz[3])
+MURK_API void murk_cie1931(int i, double cmf[3])
+{
+    for (int j = 0; j < 3; j++)
+        cmf[j] = i >= 0 && i < 95 ? cie1931_5nm[i][j] : 0.0;
+}
+
+MURK_API void murk_blackbody_xyz(double T, double xyz[3])
 {
     xyz[0] = xyz[1] = xyz[2] = 0.0;
     if (!(T > 0.0) || !isfinite(T))
@@ -70,7 +77,7 @@ void murk_blackbody_xyz(double T, double xyz[3])
         xyz[j] /= ysum;
 }
 
-murk_rgb murk_blackbody_rgb(double T)
+MURK_API murk_rgb murk_blackbody_rgb(double T)
 {
     double x[3];
     murk_blackbody_xyz(T, x);
@@ -80,7 +87,7 @@ murk_rgb murk_blackbody_rgb(double T)
     return murk_rgb3((float)fmax(r, 0.0), (float)fmax(g, 0.0), (float)fmax(b, 0.0));
 }
 
-int murk_blackbody_table_build(murk_blackbody_table *t, double tmax)
+MURK_API int murk_blackbody_table_build(murk_blackbody_table *t, double tmax)
 {
     t->n = 0;
     t->rgb = NULL;
@@ -99,7 +106,7 @@ int murk_blackbody_table_build(murk_blackbody_table *t, double tmax)
     return 0;
 }
 
-void murk_blackbody_table_free(murk_blackbody_table *t)
+MURK_API void murk_blackbody_table_free(murk_blackbody_table *t)
 {
     free(t->rgb);
     t->rgb = NULL;

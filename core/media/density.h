@@ -115,6 +115,8 @@ int murk_dda_next(murk_dda *it, float *ta, float *tb, float *maj, float *min);
  * 1931 2-degree colour-matching functions (5 nm, 360..830 nm) over the integral of ybar: CIE XYZ; then
  * linear sRGB (D65), negative channels set to 0. T <= 0 or not finite: black. */
 void murk_blackbody_xyz(double T, double xyz[3]);
+/* Row i (360 + 5 i nm, i in [0, 94]) of the CIE 1931 table blackbody.c integrates with: xbar, ybar, zbar. */
+void murk_cie1931(int i, double cmf[3]);
 murk_rgb murk_blackbody_rgb(double T);
 
 /* murk_blackbody_rgb tabulated over [0, tmax] in n equal steps (at most 1 K apart, at most
