@@ -68,6 +68,7 @@ static const struct command_help {
      "               --all the parameters (what tools/plugin_docs.py writes into README.md and docs/plugins.md)\n"},
     {"compare",
      "usage: murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+     "                    [--html PAGE.html]\n"
      "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) with its standard error, the mean absolute relative error,\n"
      "a bias test (mean of a-b with its standard error and z-score) and, from the EXRs' render times and cost\n"
      "counters, the efficiency 1/(relMSE x seconds) and 1/(relMSE x density lookups).\n"
@@ -75,7 +76,9 @@ static const struct command_help {
      "  --json           one JSON object instead of text\n"
      "  --diff D.png     a heat map of |a-b| (white = the 99th percentile) and D_signed.png, the signed relative\n"
      "                   difference (a-b)/(|b|+0.01) on a fixed scale: blue -S, white 0, red +S\n"
-     "  --scale S        that scale (default 1)\n"},
+     "  --scale S        that scale (default 1)\n"
+     "  --html P.html    the interactive comparison page: both images (flip, split, zoom, exposure), the error\n"
+     "                   and efficiency maps and these figures, in one self-contained file\n"},
     {"bench", NULL}, /* bench.c prints its own (murk bench --help) */
     {"merge",
      "usage: murk merge OUT.exr PART.exr...\n"

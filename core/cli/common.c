@@ -19,7 +19,7 @@ const char murk_cli_usage_text[] =
     "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
     "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
     "  murk plugins [--markdown] [--all | NAME]\n"
-    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]] [--html PAGE.html]\n"
     "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
     "  murk check [--seed S] [--quick] PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"

@@ -254,12 +254,13 @@ static void add_light(path *st, murk_rgb le, float w, int term)
 #endif
 
 /* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side; the
- * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside) or the medium's
+ * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside), prepared once for
+ * the vertex (its textures read once for light sampling and BSDF sampling alike), or the medium's
  * phase function (mat == NULL). */
 typedef struct vertex {
     murk_vec3 p, offset_n, wo; /* offset_n: the geometric normal at a surface flipped to wo's side, zero in a medium */
     const murk_material *mat;
-    const murk_hit *hit;
+    const murk_shading *sp; /* the material's shading point at the vertex */
     murk_vec3 t, b, n, wo_local;
     const murk_medium *medium; /* the medium whose phase function scatters (mat == NULL) */
     const murk_medium *behind; /* the medium on the far side of the surface from wo */
@@ -282,7 +283,7 @@ static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
     murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
     if (!vertex_side_ok(v, wi, wl))
         return murk_rgb1(0.0f);
-    return murk_rgb_scale(v->mat->vt->eval(v->mat->self, v->hit, v->wo_local, wl), fabsf(wl.z));
+    return murk_rgb_scale(murk_material_eval(v->mat, v->sp, v->wo_local, wl), fabsf(wl.z));
 }
 
 /* The solid-angle pdf with which the vertex samples wi. */
@@ -290,7 +291,7 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
         return h->medium_phase_eval(v->medium, v->wo, wi);
-    return v->mat->vt->pdf(v->mat->self, v->hit, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
+    return murk_material_pdf(v->mat, v->sp, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
 }
 
 static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v,
@@ -537,7 +538,8 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     v.wo = wo;
     v.mat = hit->material;
     murk_hit mh = *hit; /* the material's copy: n on wo's side */
-    v.hit = &mh;
+    murk_shading sp;
+    v.sp = &sp;
     v.offset_n = hit->ng;
     v.n = hit->n;
     v.behind = murk_dot(hit->ng, wo) >= 0.0f ? hit->interior : hit->exterior; /* the medium beyond the surface */
@@ -546,6 +548,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         v.n = murk_neg(v.n);
     }
     mh.n = v.n;
+    murk_material_prepare(v.mat, &mh, &sp);
     murk_basis(v.n, &v.t, &v.b);
     v.wo_local = murk_to_local(wo, v.t, v.b, v.n);
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
@@ -558,7 +561,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     u[2] = murk_sample_1d(rng); /* PT_SLOT_LOBE */
     murk_bsdf_sample bs;
     bs.eta = 1.0f; /* a material built before ABI 1.3 does not write it */
-    if (!v.mat->vt->sample(v.mat->self, v.hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
+    if (!murk_material_sample(v.mat, &sp, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
         return 0;
     if (!finite3(bs.f) || !isfinite(bs.pdf) || !isfinite(bs.wi.x + bs.wi.y + bs.wi.z))
         return broken(h, "material", v.mat->name, "sample");

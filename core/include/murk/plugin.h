@@ -26,10 +26,11 @@
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
  * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h);
- * 1.6 appends murk_host.boundaries; 1.7 adds the phase-function kind (murk/phase.h), murk_host's
- * medium_phase_eval / medium_phase_sample / albedo / emission, murk_medium_data's fields and
+ * 1.6 appends murk_host.boundaries; 1.7 appends the material's prepare() and prepared eval/pdf/sample
+ * (textures read once per vertex, murk/material.h); 1.8 adds the phase-function kind (murk/phase.h),
+ * murk_host's medium_phase_eval / medium_phase_sample / albedo / emission, murk_medium_data's fields and
  * integrator_minor, murk_medium_event's emitted and null_prob, murk_path_ctx's pdf_ratio and flags
- * (murk/medium.h: albedo and emission fields, volume emission).
+ * (murk/medium.h: albedo and emission fields, volume emission); MURK_ABI_FIELDS_MINOR names it.
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -61,7 +62,10 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 7
+#define MURK_ABI_MINOR 8
+/* The minor that appended phase-function plugins and medium fields (the history below): plugins and the
+ * core compare another plugin's minor with it, never with a number. */
+#define MURK_ABI_FIELDS_MINOR 8
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
@@ -83,7 +87,7 @@ typedef enum murk_kind {
     MURK_KIND_MEDIUM = 2,
     MURK_KIND_INTEGRATOR = 3,
     MURK_KIND_TRANSMITTANCE = 4, /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
-    MURK_KIND_PHASE = 5          /* ABI 1.7: phase functions (murk/phase.h) */
+    MURK_KIND_PHASE = 5          /* ABI 1.8: phase functions (murk/phase.h) */
 } murk_kind;
 
 /* ---- Parameter schema ---------------------------------------------------------------------- */
@@ -195,12 +199,12 @@ typedef struct murk_host {
      * every surface occluded() can find has a material: a shadow ray it reports blocked is blocked,
      * with no intersect() to tell a boundary from an occluder. */
     size_t (*boundaries)(const murk_scene *scene);
-    /* ABI 1.7: medium m's phase function (its `phase:` block, else Henyey-Greenstein of its g;
+    /* ABI 1.8: medium m's phase function (its `phase:` block, else Henyey-Greenstein of its g;
      * murk/phase.h). medium_phase_eval is p(wo, wi) and the pdf of medium_phase_sample, which draws wi
      * from the uniforms u, sets *pdf and returns the value p(wo, wi) (0: no sample). */
     float (*medium_phase_eval)(const murk_medium *m, murk_vec3 wo, murk_vec3 wi);
     float (*medium_phase_sample)(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf);
-    /* ABI 1.7: a medium's fields beside its density at a world point (murk/medium.h: which a medium has is
+    /* ABI 1.8: a medium's fields beside its density at a world point (murk/medium.h: which a medium has is
      * murk_medium_data.fields): the single-scattering albedo per channel, and the radiance Le emitted per
      * unit absorption (the medium emits sigma_a(p) Le(p) per unit length). Each is one lookup, counted
      * like a density lookup. */
