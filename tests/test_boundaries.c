@@ -116,7 +116,7 @@ static void test_shadow(void **state)
             fail_msg("%s", err);
         const murk_medium *med = &s->media[0].m;
         for (int media = 1; media >= 0; media--) {
-            murk_pt pt = {murk_host_table(), 64, 3, 1, media, MURK_LIGHT_AREA, 1.0f, 0};
+            murk_pt pt = {murk_host_table(), 64, 3, 1, media, MURK_LIGHT_AREA, 1.0f, 0, 0};
             for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
                 const shadow_case *sc = &cases[c];
                 double d = inside_length(sc->p, sc->q), s1[3] = {0}, s2[3] = {0};

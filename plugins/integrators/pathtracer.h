@@ -38,7 +38,7 @@
 enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 /* volpath_nee's: the shared ones, then its own. */
-enum { MURK_PT_EQUIANGULAR = MURK_PT_NPARAMS, MURK_PT_NEE_NPARAMS };
+enum { MURK_PT_EQUIANGULAR = MURK_PT_NPARAMS, MURK_PT_NEE_MIS, MURK_PT_NEE_NPARAMS };
 extern const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS];
 
 typedef struct murk_pt {
@@ -50,6 +50,7 @@ typedef struct murk_pt {
     float rr_threshold; /* Russian roulette's survival probability is min(1, weight / rr_threshold) (0: 1) */
     int equiangular;    /* volpath_nee: equiangular distance sampling towards a light point per medium
                          * segment, MIS-combined with the tracker's free flights (pathtracer.c) */
+    int nee_mis;        /* volpath_nee: nee_mis null_scattering, path-level MIS (pathtracer.c) */
 } murk_pt;
 
 /* create() for an integrator with the given strategy (params: murk_pt_nee_params when nee, else

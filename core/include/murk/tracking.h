@@ -448,6 +448,59 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
     return T;
 }
 
+/* Plain ratio tracking for path-level MIS of next-event estimation with free flights (Miller, Georgiev,
+ * Jarosz 2019, §5; volpath_nee's nee_mis: null_scattering): tentative collisions at the free flights' own
+ * majorant, max density x max_c sigma_t,c per cell (no control), each multiplying channel c's estimate
+ * by 1 - sigma_t,c(x) / mu and *pnull (per channel) by the probability with which channel c's delta
+ * tracking would have taken that collision as null, 1 - murk_real_prob(a_c, 1 - a_c) — the same as the
+ * estimate's factor while the majorant bounds. Russian roulette (below 0.1, as murk_ratio_tracking)
+ * scales the estimate, never *pnull, which is a pdf of the path's null vertices, not an estimate. */
+static inline murk_rgb murk_ratio_tracking_null(const murk_host *h, const murk_medium_data *d, const murk_ray *ray,
+                                                murk_rng *rng, murk_rgb *pnull)
+{
+    murk_rgb st = murk_sigma_t(d), T = murk_rgb1(1.0f), P = murk_rgb1(1.0f);
+    float smax = murk_rgb_max(st);
+    if (!(smax > 0.0f)) {
+        *pnull = P;
+        return T;
+    }
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
+    murk_majorant_walk w;
+    h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
+    float ta, tb, dmax, dmin;
+    long steps = 0;
+    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin) && steps <= MURK_WATCHDOG_ITERATIONS) {
+        float mu = dmax * smax;
+        for (float t = ta; mu > 0.0f && ++steps <= MURK_WATCHDOG_ITERATIONS;) {
+            t = murk_advance(t, murk_sample_exp(rng, mu));
+            if (!(t < tb))
+                break;
+            count->collisions++;
+            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
+            for (int k = 0; k < 3; k++) {
+                float a = dens * st.c[k] / mu;
+                T.c[k] *= 1.0f - a;
+                P.c[k] *= 1.0f - murk_real_prob(a, 1.0f - a);
+            }
+            float tm = fmaxf(fabsf(T.c[0]), fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
+            if (tm < 0.1f) { /* Russian roulette on the estimate only */
+                if (tm <= 0.0f || murk_rng_float(rng) >= tm) {
+                    *pnull = P;
+                    return murk_rgb1(0.0f);
+                }
+                T = murk_rgb_scale(T, 1.0f / tm);
+            }
+        }
+    }
+    if (steps > MURK_WATCHDOG_ITERATIONS) {
+        h->warn_once("medium '%s': ratio tracking exceeded %ld iterations (MURK_WATCHDOG_ITERATIONS); "
+                     "transmittance set to 0 (biased)", d->name, MURK_WATCHDOG_ITERATIONS);
+        T = murk_rgb1(0.0f);
+    }
+    *pnull = P;
+    return T;
+}
+
 /* Ray-marched integral of the density (not of sigma_t) over (ray->tmin, ray->tmax), walked over the
  * majorant grid: segments whose majorant is 0 are skipped (no lookups; the walk ends at the field's box,
  * so infinite rays terminate). Two ways to place the lookups, each with an offset u in [0, 1):
