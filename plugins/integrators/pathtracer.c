@@ -196,6 +196,8 @@ static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, 
     const murk_host *h = pt->host;
     const float end_eps = 1e-4f * murk_maxf(1.0f, maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
+    if (pnull)
+        *pnull = T;
     if (!pt->media)
         m = NULL;
     murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, murk_sub(q, p)) : p;
@@ -363,7 +365,7 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
         return f;
     /* a light behind a transmitting surface is reached through the medium on that side */
     const murk_medium *m = v->mat && murk_dot(ls->wi, v->offset_n) < 0.0f ? v->behind : st->medium;
-    murk_rgb P = murk_rgb1(1.0f);
+    murk_rgb P; /* nee_mis: the shadow ray's null-collision probabilities (shadow() sets them) */
     murk_rgb T = shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m, &st->ctx, rng,
                         pt->nee_mis ? &P : NULL);
     if (murk_rgb_is_black(T))
@@ -522,12 +524,15 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     st->ctx.pdf_ratio = st->R;
     murk_sample_seek(rng, PT_SLOT_FLIGHT(st->depth, st->crossings));
     m->vt->sample(m->self, &seg, &st->ctx, rng, &ev);
-    if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t)) || !finite3(ev.emitted)) {
+    if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t))) {
         broken(h, "medium", m->name, "free-flight weight");
         return PT_END;
     }
-    if (!murk_rgb_is_black(ev.emitted)) /* credited with beta and R before the flight */
+    if (!murk_rgb_is_black(ev.emitted)) { /* credited with beta and R before the flight */
+        if (!finite3(ev.emitted))
+            return broken(h, "medium", m->name, "emitted radiance"), PT_END;
         add_light(st, ev.emitted, 1.0f, MURK_PT_TERM_MEDIUM_EMISSION);
+    }
     st->beta = murk_rgb_mul(st->beta, ev.weight);
     st->R = murk_rgb_mul(st->R, ev.pdf_ratio);
     if (murk_rgb_is_black(st->beta) || !(mean3(st->R) > 0.0f))
@@ -539,7 +544,8 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
                          "ended (biased)", m->name);
             return PT_END;
         }
-        st->null_hero *= pt->nee_mis ? ev.null_prob : 1.0f;
+        if (pt->nee_mis)
+            st->null_hero *= ev.null_prob;
         return PT_PASSED;
     }
     if (st->depth >= pt->max_depth)
@@ -558,18 +564,19 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     float p = h->medium_phase_sample(m, v.wo, u, &wi, &pdf);
     if (!(pdf > 0.0f))
         return PT_END;
-    if (!isfinite(p) || !isfinite(wi.x + wi.y + wi.z)) {
-        broken(h, "phase function of medium", m->name, "sample");
-        return PT_END;
-    }
-    if (p != pdf) /* murk's phase functions sample exactly (p / pdf = 1): beta stays */
+    if (p != pdf) { /* murk's phase functions sample exactly (p / pdf = 1): beta stays */
+        if (!isfinite(p) || !isfinite(pdf))
+            return broken(h, "phase function of medium", m->name, "sample"), PT_END;
         st->beta = murk_rgb_scale(st->beta, p / pdf);
+    }
     st->prev_p = v.p;
     st->prev_pdf = pdf;
     st->prev_delta = 0;
     st->prev_phase = 1;
-    st->R_vertex = st->R;
-    st->null_hero = 1.0f;
+    if (pt->nee_mis) {
+        st->R_vertex = st->R;
+        st->null_hero = 1.0f;
+    }
     st->ray = ray_from(v.p, wi);
     st->depth++;
     return PT_SCATTERED;
@@ -653,8 +660,10 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     st->prev_pdf = bs.pdf;
     st->prev_delta = bs.delta;
     st->prev_phase = 0;
-    st->R_vertex = st->R;
-    st->null_hero = 1.0f;
+    if (pt->nee_mis) {
+        st->R_vertex = st->R;
+        st->null_hero = 1.0f;
+    }
     st->ray = ray_from(offset(hit->p, v.offset_n, wi), wi);
     st->depth++;
     return 1;

@@ -20,6 +20,15 @@
 
 #include "murk/medium.h"
 
+/* Inlined wherever it is called, whatever the compiler's size heuristics: the collision loop's helpers, so
+ * that a tracker that writes its loop twice (see "Fields beside density" below) gets each instance with
+ * no call per collision. */
+#if defined(__GNUC__)
+#define MURK_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define MURK_ALWAYS_INLINE inline
+#endif
+
 /* What every tracker keeps; put it first in a tracker's own struct. */
 typedef struct murk_tracker {
     const murk_host *host;
@@ -103,7 +112,7 @@ static inline int murk_flight_stratified(const murk_medium_data *d)
 
 /* A uniform number in [0, 1): if *first (which it clears) the slot's — with sobol its first coordinate,
  * the second kept in *uc for murk_flight_choice — else the PCG stream's. */
-static inline float murk_flight_float(murk_rng *rng, int *first, float *uc)
+static MURK_ALWAYS_INLINE float murk_flight_float(murk_rng *rng, int *first, float *uc)
 {
     if (!*first)
         return murk_rng_float(rng);
@@ -124,7 +133,7 @@ static inline float murk_flight_exp(murk_rng *rng, int *first, float *uc, float 
 
 /* The number for a collision's choice: the slot's second coordinate if murk_flight_float left one in
  * *uc (which it clears), else the PCG stream's. */
-static inline float murk_flight_choice(murk_rng *rng, float *uc)
+static MURK_ALWAYS_INLINE float murk_flight_choice(murk_rng *rng, float *uc)
 {
     float u = *uc;
     *uc = -1.0f;
@@ -273,7 +282,7 @@ static inline void murk_collisions_raise(murk_collisions *c, float amax)
  * it was drawn with. Returns 0 when the ray's segment is used up — or when the watchdog stopped it
  * (c->stopped, reported once; the caller ends the path with murk_event_kill). Every iteration advances
  * t by at least one float or moves to the next cell, so the loop ends. */
-static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
+static MURK_ALWAYS_INLINE int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
 {
     for (;;) {
         if (++c->steps > MURK_WATCHDOG_ITERATIONS) {
@@ -310,7 +319,7 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
 /* The number for the choice at the collision murk_collisions_next() just returned (real or null,
  * absorbed or scattered): at the first collision of a stratified flight with sobol the slot's second
  * coordinate, else the PCG stream's. Draw it with this, not murk_rng_float. */
-static inline float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
+static MURK_ALWAYS_INLINE float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
 
 /* ---- Fields beside density (ABI 1.8; murk/medium.h) ---------------------------------------------------
  * A medium with an albedo field or emission (t->fields != 0) needs more per collision than one without, so
@@ -334,12 +343,6 @@ static inline float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { 
  * unbiased too, but in a thin flame real collisions are rare, while every null collision scores here.)
  * Decomposition tracking's two processes together are one of rate control + residual; spectral MIS
  * credits each score with the pdf ratios the path has at that collision (murk_emit's r). */
-#if defined(__GNUC__)
-#define MURK_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define MURK_ALWAYS_INLINE inline
-#endif
-
 /* 1 if the flight must collect emission: the medium emits and the integrator passes events that hold it. */
 static inline int murk_emitting(const murk_tracker *t)
 {
