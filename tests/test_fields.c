@@ -12,7 +12,7 @@
  *     0.3768), (0.3135, 0.3237)), and murk's XYZ against this test's own integration of Planck's law
  *     (Simpson's rule on the same 5 nm table) within 1e-3;
  *   - bad input: negative or NaN emission / temperature / albedo, albedo above 1, temperature keys
- *     without a temperature, a tracker built before ABI 1.8 on a medium with fields: located errors,
+ *     without a temperature, a tracker built before ABI 1.9 on a medium with fields: located errors,
  *     nothing written; density and temperature grids of different boxes and sizes are allowed. */
 #include "mediatest.h"
 
@@ -34,7 +34,7 @@ static int setup(void **state)
     return 0;
 }
 
-/* One flight as an integrator of ABI 1.8 makes it (beta 1, pdf ratios 1, uniform hero): x = emitted, y =
+/* One flight as an integrator of ABI 1.9 makes it (beta 1, pdf ratios 1, uniform hero): x = emitted, y =
  * the event's weight over its mean pdf ratio. */
 static void flight(const murk_medium *m, const murk_ray *ray, murk_rng *rng, double x[3], double y[3])
 {
@@ -351,7 +351,7 @@ static void test_bad_input(void **state)
     expect_error("e_grid.yaml", "delta", keys, "invalid value");
     expect_error("t_scale.yaml", "delta", "temperature_scale: 100", "need a temperature field");
     expect_error("t_const.yaml", "delta", "temperature: { constant: -3 }", "temperature.constant must be");
-    expect_error("old.yaml", "old_tracker", "emission: 1", "built for plugin ABI 1.6");
+    expect_error("old.yaml", "old_tracker", "emission: 1", "built for plugin ABI 1.8");
 }
 
 /* Density and temperature of different boxes and resolutions: allowed (each field has its own box, 0

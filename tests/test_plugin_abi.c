@@ -17,6 +17,13 @@
 #include "plugin/plugin_loader.h"
 #include "scene/scene.h"
 
+/* The host's ABI minor as text (and the next one, which the abi_minor fixture asks for). */
+#define STR_(x) #x
+#define STR(x) STR_(x)
+#define MINOR STR(MURK_ABI_MINOR)
+_Static_assert(MURK_ABI_MINOR == 9, "update MINOR_PLUS_1 with the ABI minor");
+#define MINOR_PLUS_1 "10"
+
 static char err[2048];
 
 static const char *fixture_dir(void) { return build_path("tests/fixtures"); }
@@ -78,8 +85,8 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case bad_cases[] = {
-    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.8"},
-    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.9, this murk has ABI 1.8"},
+    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1." MINOR},
+    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1." MINOR_PLUS_1 ", this murk has ABI 1." MINOR},
     {"no_entry", MURK_KIND_MATERIAL, "no 'murk_plugin_entry' function"},
     {"no_abi", MURK_KIND_MATERIAL, "no 'murk_plugin_abi' symbol: not a murk plugin"},
     {"bad_size", MURK_KIND_MATERIAL, "descriptor struct_size is"},
@@ -121,7 +128,7 @@ static void test_open_bad_details(void **state)
     murk_plugin p;
     char want[256];
     assert_int_equal(murk_plugin_open(fixture("bad_size"), 0, &p, err, sizeof err), -1);
-    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.8",
+    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1." MINOR,
              MURK_PLUGIN_DESC_SIZE_1_0 - sizeof(void *), MURK_PLUGIN_DESC_SIZE_1_0);
     assert_contains(err, want);
 
@@ -181,7 +188,7 @@ static void test_open_not_a_library(void **state)
     /* another major ABI with an aborting constructor: refused from the symbol table, never loaded */
     const char *ctor = fixture("abi_ctor");
     assert_int_equal(murk_plugin_open(ctor, 0, &p, err, sizeof err), -1);
-    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.8");
+    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1." MINOR);
     assert_null(strchr(err, '\n'));
 }
 
@@ -568,7 +575,7 @@ static void test_cli_render_fixtures(void **state)
     const char *plugins = murk_image_meta(&img, "murk:plugins");
     assert_non_null(plugins);
     char rec[1300];
-    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1.8)", fixture("good_fixture"));
+    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1." MINOR ")", fixture("good_fixture"));
     assert_contains(plugins, rec);
     assert_contains(plugins, "path=");
     murk_image_free(&img);
@@ -669,7 +676,7 @@ static void test_cli_plugins(void **state)
     free(out);
     st = run_murk(&out, "plugins", "abi_major", NULL);
     assert_int_equal(st, 1);
-    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.8");
+    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1." MINOR);
     assert_contains(out, fixture("abi_major"));
     free(out);
     st = run_murk(&out, "plugins", "good_fixture", NULL);

@@ -9,6 +9,7 @@
 #include "render/accel.h"
 #include "render/checkpoint.h"
 #include "render/host.h"
+#include "render/lights.h"
 #include "scene/obj.h"
 #include "scene/params.h"
 #include "util/limit.h"
@@ -539,7 +540,7 @@ static int check_unused(const murk_ynode *root, int only_set, char *err, size_t 
 static int load_document(murk_scene *s, char *err, size_t errlen)
 {
     static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
-                                       "materials", "media", "shapes"};
+                                       "materials", "media", "shapes", "lights"};
     const murk_ynode *root = s->doc.root;
     if (!root)
         return murk_yerr(err, errlen, &(murk_ynode){.file = s->doc.file, .line = 1, .col = 1},
@@ -575,7 +576,10 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         murk_media_bind_integrator(s, murk_ymap_get(root, "media"), s->integrator_plugin->desc->name,
                                    s->integrator_plugin->abi.minor, err, errlen))
         return -1;
-    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen))
+    /* an integrator built before the lights' ABI gets only emissive shapes to sample (render/lights.h) */
+    s->legacy_lights = s->integrator_plugin->abi.minor < MURK_ABI_MINOR_LIGHTS;
+    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen) ||
+        murk_load_lights(s, murk_ymap_get(root, "lights"), err, errlen))
         return -1;
     murk_vec3 lo, hi;
     scene_bounds(s, &lo, &hi);
@@ -628,6 +632,10 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
                 return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;
+    const murk_ynode *lights = murk_ymap_get(root, "lights");
+    for (size_t i = 0; lights && lights->kind == MURK_Y_SEQ && i < lights->n; i++) /* environment maps */
+        if (names(lights->items[i], "type", "envmap") && hash_input(s, murk_ymap_get(lights->items[i], "file"), &h, err, errlen))
+            return 0;
     return h ? h : 1;
 }
 
@@ -649,10 +657,10 @@ MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, 
             murk_scene_free(s);
             return NULL;
         }
-    if (load_document(s, err, errlen) != 0 || murk_accel_build(s, err, errlen) != 0) {
+    if (load_document(s, err, errlen) != 0 || murk_accel_build(s, err, errlen) != 0 ||
+        murk_lights_build(s, err, errlen) != 0) {
         murk_scene_free(s);
         return NULL;
     }
-    murk_lights_build(s);
     return s;
 }

@@ -20,6 +20,10 @@ int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
  * any of them changed is refused. 0 with err if one cannot be read. */
 uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
 
+/* The `lights:` list (light_block.c): each light checked and added (render/lights.h). 0, or -1 with a
+ * located err. */
+int murk_load_lights(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+
 /* Releases what a shape owns (its triangle arrays). */
 void murk_shape_free(murk_shape *sh);
 

@@ -311,19 +311,19 @@ static int load_extras(murk_scene *s, const murk_host *host, const char *name, c
                             &nm->density->fields, &nm->data, err, errlen);
 }
 
-/* A tracker built before ABI 1.8 knows nothing of albedo or emission fields: it would render the medium
+/* A tracker built before ABI 1.9 knows nothing of albedo or emission fields: it would render the medium
  * without them. */
 static int check_tracker_fields(const murk_plugin *p, const murk_medium_data *md, const murk_ynode *m,
                                 const char *who, char *err, size_t errlen)
 {
-    if (!md->fields || p->abi.minor >= MURK_ABI_FIELDS_MINOR)
+    if (!md->fields || p->abi.minor >= MURK_ABI_MINOR_FIELDS)
         return 0;
     const murk_ynode *at = murk_ymap_get(m, md->fields & MURK_FIELD_ALBEDO ? "albedo" : "emission");
     if (!at)
         at = murk_ymap_get(m, "temperature");
     return murk_yerr(err, errlen, at ? at : m, "%s: tracker '%s' was built for plugin ABI %u.%u, before albedo and "
                      "emission fields (1.%d), and would ignore them; rebuild it, or use one of murk's trackers", who,
-                     p->desc->name, p->abi.major, p->abi.minor, MURK_ABI_FIELDS_MINOR);
+                     p->desc->name, p->abi.major, p->abi.minor, MURK_ABI_MINOR_FIELDS);
 }
 
 static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m,
@@ -465,7 +465,7 @@ int murk_media_bind_integrator(murk_scene *s, const murk_ynode *media_node, cons
     for (size_t i = 0; i < s->nmedia; i++) {
         murk_medium_data *md = &s->media[i].data;
         md->integrator_minor = minor;
-        if (!(md->fields & MURK_FIELD_EMISSION) || minor >= MURK_ABI_FIELDS_MINOR)
+        if (!(md->fields & MURK_FIELD_EMISSION) || minor >= MURK_ABI_MINOR_FIELDS)
             continue;
         const murk_ynode *m = media_node ? murk_ymap_get(media_node, s->media[i].name) : NULL, *at = NULL;
         if (m && !(at = murk_ymap_get(m, "emission")))
@@ -473,7 +473,7 @@ int murk_media_bind_integrator(murk_scene *s, const murk_ynode *media_node, cons
         murk_ynode here = {.file = s->doc.file, .line = 0, .col = 0};
         return murk_yerr(err, errlen, at ? at : m ? m : &here, "medium '%s' emits, and integrator '%s' was built for "
                          "plugin ABI 1.%u, before volume emission (1.%d): it would not collect it; rebuild it, or use "
-                         "volpath or volpath_nee", s->media[i].name, integrator, minor, MURK_ABI_FIELDS_MINOR);
+                         "volpath or volpath_nee", s->media[i].name, integrator, minor, MURK_ABI_MINOR_FIELDS);
     }
     return 0;
 }

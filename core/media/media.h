@@ -30,7 +30,7 @@ struct murk_field;
 struct murk_field *murk_media_scalar_field(const murk_scene *s, const murk_ynode *d, const char *what, char *err,
                                            size_t errlen);
 /* Tells every medium the ABI minor of the scene's integrator (murk_medium_data.integrator_minor) and refuses
- * an emitting medium with an integrator built before ABI 1.8 (a located error at its emission or
+ * an emitting medium with an integrator built before ABI 1.9 (a located error at its emission or
  * temperature key of media_node). */
 int murk_media_bind_integrator(murk_scene *s, const murk_ynode *media_node, const char *integrator, uint32_t minor,
                                char *err, size_t errlen);
@@ -52,7 +52,7 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
 murk_counters *murk_media_counters(const murk_density *d);
 float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi);
 murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf);
-/* The host's medium services of ABI 1.8 (murk/plugin.h): a medium's phase function, albedo and emission. */
+/* The host's medium services of ABI 1.9 (murk/plugin.h): a medium's phase function, albedo and emission. */
 float murk_media_phase_eval(const murk_medium *m, murk_vec3 wo, murk_vec3 wi);
 float murk_media_phase_sample(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf);
 murk_rgb murk_media_albedo(const murk_density *d, murk_vec3 p);

@@ -140,7 +140,7 @@ static size_t vtable_min_size(int kind)
     case MURK_KIND_MEDIUM: return MURK_MEDIUM_VT_SIZE_1_0;
     case MURK_KIND_INTEGRATOR: return MURK_INTEGRATOR_VT_SIZE_1_0;
     case MURK_KIND_TRANSMITTANCE: return MURK_TRANSMITTANCE_VT_SIZE_1_2; /* the kind's first ABI */
-    case MURK_KIND_PHASE: return MURK_PHASE_VT_SIZE_1_8;
+    case MURK_KIND_PHASE: return MURK_PHASE_VT_SIZE_1_9;
     default: return 0;
     }
 }

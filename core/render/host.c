@@ -4,6 +4,7 @@
 #include "render/host.h"
 #include "media/media.h"
 #include "render/accel.h"
+#include "render/lights.h"
 #include "scene/scene.h"
 #include "scene/texture.h"
 #include "util/runtime.h"
@@ -182,10 +183,23 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     return er.tfar < 0.0f;
 }
 
-/* Light sampling lives in lights.c; 1.3's services are the area strategy. */
+/* Light sampling lives in lights.c. An integrator older than MURK_ABI_MINOR_LIGHTS holds a shorter
+ * murk_light_sample (no flags): it gets that much, filled from a whole one. */
+static int host_sample_light_with(const murk_scene *s, murk_vec3 p, const float u[3], int strategy,
+                                  murk_light_sample *ls)
+{
+    if (!s->legacy_lights)
+        return murk_lights_sample(s, p, u, strategy, ls);
+    murk_light_sample whole;
+    int ok = murk_lights_sample(s, p, u, strategy, &whole);
+    memcpy(ls, &whole, MURK_LIGHT_SAMPLE_SIZE_1_6);
+    return ok;
+}
+
+/* 1.3's services are the area strategy. */
 static int host_sample_light(const murk_scene *s, murk_vec3 p, const float u[3], murk_light_sample *ls)
 {
-    return murk_lights_sample(s, p, u, MURK_LIGHT_AREA, ls);
+    return host_sample_light_with(s, p, u, MURK_LIGHT_AREA, ls);
 }
 
 static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
@@ -193,11 +207,6 @@ static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
     return murk_lights_pdf(s, p, h, MURK_LIGHT_AREA);
 }
 
-static murk_rgb host_background(const murk_scene *s, murk_vec3 dir)
-{
-    (void)dir;
-    return s->background;
-}
 
 static const murk_medium *host_camera_medium(const murk_scene *s) { return s->camera_medium; }
 
@@ -215,7 +224,7 @@ static const murk_host host_table = {
     .occluded = host_occluded,
     .sample_light = host_sample_light,
     .light_pdf = host_light_pdf,
-    .background = host_background,
+    .background = murk_lights_background,
     .camera_medium = host_camera_medium,
     .density = murk_media_density,
     .walk_init = murk_media_walk_init,
@@ -224,9 +233,10 @@ static const murk_host host_table = {
     .phase_eval = murk_phase_hg_eval,
     .phase_sample = murk_phase_hg_sample,
     .counters = murk_media_counters,
-    .sample_light_with = murk_lights_sample,
+    .sample_light_with = host_sample_light_with,
     .light_pdf_with = murk_lights_pdf,
     .boundaries = host_boundaries,
+    .environment_pdf = murk_lights_environment_pdf,
     .medium_phase_eval = murk_media_phase_eval,
     .medium_phase_sample = murk_media_phase_sample,
     .albedo = murk_media_albedo,

@@ -30,14 +30,32 @@ typedef struct murk_shape {
     float radius;
 } murk_shape;
 
+/* What a light is: an emitting triangle or sphere of a shape (render/lights.c), or one of the scene's
+ * `lights:` (load/light_block.c, or C: render/lights.h). */
+typedef enum murk_light_kind {
+    MURK_LK_TRIANGLE = 0,
+    MURK_LK_SPHERE = 1,
+    MURK_LK_POINT,   /* center, le = intensity (W/sr) */
+    MURK_LK_SPOT,    /* center, n = axis (where it shines), le = intensity, cos_falloff, cos_cone */
+    MURK_LK_DISTANT, /* n = unit direction towards it, le = irradiance E; omc > 0: a cone, radiance lc */
+    MURK_LK_ENVMAP   /* env (NULL: a constant environment of radiance le); part of the environment */
+} murk_light_kind;
+
+typedef struct murk_envmap murk_envmap; /* a lat-long environment map (render/envmap.h) */
+
 typedef struct murk_light {
     uint32_t geom, prim;
-    int sphere;
+    int kind; /* murk_light_kind */
     murk_vec3 p0, e1, e2, n; /* triangle: p0 + a e1 + b e2; unit normal (emitting side) */
     murk_vec3 center;        /* sphere */
     float radius, area;
     float pmf; /* probability of picking this light */
     murk_rgb le;
+    /* spot: the cosines of falloff_angle (full intensity) and cone_angle (none); distant: 1 - cos of
+     * its cone's half-angle (0: a delta light) and the radiance inside the cone */
+    float cos_falloff, cos_cone, omc;
+    murk_rgb lc;
+    const murk_envmap *env;
     /* a triangle of a rectangle (a quad or box face: two triangles): the rectangle p0 + a ex + b ey,
      * a, b in [0, 1], and the probability of picking either of its triangles (MURK_LIGHT_SOLID_ANGLE) */
     int rect;
@@ -93,6 +111,17 @@ struct murk_scene {
     size_t nlights;
     float *light_cdf; /* nlights + 1 */
     float light_power;
+    /* the `lights:` block's lights (and those added from C), until murk_lights_build appends them to
+     * `lights`; the environment maps they own */
+    murk_light *added;
+    size_t nadded;
+    murk_envmap **envmaps;
+    size_t nenvmaps;
+    /* the environment's parts (indices into lights: envmaps, finite-cone distant lights, and the constant
+     * background as a constant envmap when there are others); none: background() is the constant */
+    size_t *env;
+    size_t nenv;
+    int legacy_lights; /* the integrator predates MURK_ABI_MINOR_LIGHTS: the added lights get pmf 0 */
     RTCDevice device;
     RTCScene rtc;
 };

@@ -12,7 +12,7 @@
  * reweighted by a_k / q (real) or (1 - a_k) / (1 - q) (null): unbiased, weights bounded. The same
  * reweighting keeps the estimate unbiased should a density exceed the majorant (said once).
  *
- * Albedo and emission fields (murk/medium.h, ABI 1.8): with a field (tr->fields != 0) every tentative
+ * Albedo and emission fields (murk/medium.h, ABI 1.9): with a field (tr->fields != 0) every tentative
  * collision asks murk_local_sigma() for the local sigma_a and sigma_s (an albedo field changes the split of
  * extinction, not extinction) and, if the medium emits, adds its emission score with murk_emit(): the
  * collision estimator, sigma_a Le / mu times the running weight at every tentative collision, unbiased

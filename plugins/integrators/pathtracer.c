@@ -50,7 +50,9 @@ const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
     PT_SHARED_PARAMS
     [MURK_PT_EQUIANGULAR] = {"equiangular", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
                              "also sample each medium segment equiangularly (Kulla and Fajardo 2012) towards a "
-                             "reference point on a light, and combine that vertex's NEE with the free flight's "
+                             "reference point on a light (a point or spot light's position; a reference light at "
+                             "infinity, a distant light or the environment, has no point: that segment has free "
+                             "flights alone), and combine that vertex's NEE with the free flight's "
                              "by MIS (the balance heuristic; a per-segment exponential stands in for the free "
                              "flight's pdf, exact in a grey homogeneous medium and an approximation elsewhere, "
                              "which changes the noise, never the image). Free flights are untouched. It pays off "
@@ -190,24 +192,31 @@ static murk_ray ray_from(murk_vec3 o, murk_vec3 d)
  * early and counts the light itself as an occluder. So every leg is re-aimed at q. With pnull (nee_mis:
  * null_scattering) every medium leg is ratio-tracked at the free flights' majorant and *pnull (1 on entry)
  * gathers the null-collision probabilities of its tentative collisions (murk_ratio_tracking_null). */
+/* A light at infinity (inf = 1) is reached along wi itself: every leg keeps that direction and runs to
+ * infinity (a medium's majorant walk ends at its density's box; a constant medium is bounded by its
+ * boundary shapes). */
 static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
-                       const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng, murk_rgb *pnull)
+                       murk_vec3 wi, int inf, const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng,
+                       murk_rgb *pnull)
 {
     const murk_host *h = pt->host;
-    const float end_eps = 1e-4f * murk_maxf(1.0f, maxabs(q));
+    const float end_eps = inf ? 0.0f : 1e-4f * murk_maxf(1.0f, maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
     if (pnull)
         *pnull = T;
     if (!pt->media)
         m = NULL;
-    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, murk_sub(q, p)) : p;
+    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, inf ? wi : murk_sub(q, p)) : p;
     for (int crossings = 0; crossings < 256; crossings++) {
-        murk_vec3 d = murk_sub(q, o);
-        float len = murk_length(d);
-        if (!(len > end_eps))
-            return T;
-        murk_ray r = ray_from(o, murk_mul(d, 1.0f / len));
-        r.tmax = len - end_eps;
+        murk_ray r = ray_from(o, wi);
+        if (!inf) {
+            murk_vec3 d = murk_sub(q, o);
+            float len = murk_length(d);
+            if (!(len > end_eps))
+                return T;
+            r = ray_from(o, murk_mul(d, 1.0f / len));
+            r.tmax = len - end_eps;
+        }
         if (!m && !h->occluded(scene, &r)) /* nothing at all in the way: the common case, cheaply */
             return T;
         if (!m && !h->boundaries(scene)) /* in the way, and without boundaries it is an occluder */
@@ -247,7 +256,13 @@ static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, 
 murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
                         const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
 {
-    return shadow(pt, scene, p, offset_n, q, m, ctx, rng, NULL);
+    return shadow(pt, scene, p, offset_n, q, murk_v3(0, 0, 0), 0, m, ctx, rng, NULL);
+}
+
+murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 wi,
+                            const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    return shadow(pt, scene, p, offset_n, p, wi, 1, m, ctx, rng, NULL);
 }
 
 /* ---- path state ---------------------------------------------------------------------------- */
@@ -346,6 +361,7 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
+    ls.flags = 0;
     if (w > 0.0f && pt->host->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
         add_light(st, light_sample_value(pt, scene, st, v, &ls, rng), w, term);
 }
@@ -366,10 +382,13 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
     /* a light behind a transmitting surface is reached through the medium on that side */
     const murk_medium *m = v->mat && murk_dot(ls->wi, v->offset_n) < 0.0f ? v->behind : st->medium;
     murk_rgb P; /* nee_mis: the shadow ray's null-collision probabilities (shadow() sets them) */
-    murk_rgb T = shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m, &st->ctx, rng,
-                        pt->nee_mis ? &P : NULL);
+    int inf = isinf(ls->dist);
+    murk_rgb T = shadow(pt, scene, v->p, v->offset_n, inf ? v->p : murk_madd(v->p, ls->wi, ls->dist),
+                        inf ? ls->wi : murk_v3(0, 0, 0), inf, m, &st->ctx, rng, pt->nee_mis ? &P : NULL);
     if (murk_rgb_is_black(T))
         return T;
+    if (ls->flags & MURK_LIGHT_SAMPLE_DELTA) /* no BSDF or phase sample can hit a delta light: weight 1 */
+        return murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(f, T), ls->le), 1.0f / ls->pdf);
     float pdf = vertex_pdf(h, v, ls->wi);
     if (!isfinite(pdf)) {
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
@@ -441,8 +460,9 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
-    if (!h->sample_light_with(scene, st->ray.o, u, pt->light_strategy, &ls))
-        return;
+    ls.flags = 0;
+    if (!h->sample_light_with(scene, st->ray.o, u, pt->light_strategy, &ls) || isinf(ls.dist))
+        return; /* a light at infinity has no point to aim at: this segment has free flights alone */
     murk_vec3 q = murk_madd(st->ray.o, ls.wi, ls.dist);
     /* where the medium can scatter along the segment, and its mean density there */
     murk_majorant_walk w;
@@ -582,21 +602,26 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     return PT_SCATTERED;
 }
 
-/* The MIS weight of emission that phase or BSDF sampling found at hit, against light sampling from the
- * last vertex: the power heuristic on solid-angle pdfs, or (nee_mis: null_scattering) the balance
+/* The MIS weight of emission that phase or BSDF sampling found — an emitter's hit, or the environment
+ * (light sampling's pdf of it: pl) — against light sampling from the last vertex: the power heuristic
+ * on solid-angle pdfs, or (nee_mis: null_scattering) the balance
  * heuristic over both strategies and the channels' techniques, relative to the path's own: the found path's
  * pdf for channel k is R_k p_dir P_k and light sampling's R_vertex,k p_light (its null collisions ratio-
  * tracked, at probability 1), with R_k / R_vertex,k = P_k / P_hero, so the weight times 1 / mean(R) that
  * add_light applies is 1 / (mean(R) + mean(R_vertex) p_light / (p_dir P_hero)). */
-static float found_light_weight(const murk_pt *pt, const murk_scene *scene, const path *st, const murk_hit *hit)
+static float found_weight(const murk_pt *pt, const path *st, float pl)
 {
-    float pl = pt->host->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy);
     if (!pt->nee_mis)
         return power_heuristic(st->prev_pdf, pl);
     if (!(st->null_hero > 0.0f) || !(st->prev_pdf > 0.0f))
         return 0.0f;
     float m = mean3(st->R), d = m + mean3(st->R_vertex) * pl / (st->prev_pdf * st->null_hero);
     return d > 0.0f ? m / d : 0.0f;
+}
+
+static float found_light_weight(const murk_pt *pt, const murk_scene *scene, const path *st, const murk_hit *hit)
+{
+    return found_weight(pt, st, pt->host->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy));
 }
 
 /* Emission at a surface hit, then (below max_depth) light sampling and BSDF sampling. Returns 0 when
@@ -669,6 +694,16 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     return 1;
 }
 
+/* The MIS weight of the environment that a BSDF / phase sample of pdf st->prev_pdf found, against the
+ * light sampling that could have picked that direction (1 where none could: a constant background). */
+static float escaped_weight(const murk_pt *pt, const murk_scene *scene, const path *st)
+{
+    if (!pt->nee || st->prev_delta)
+        return 1.0f;
+    float pe = pt->host->environment_pdf(scene, st->ray.d);
+    return pe > 0.0f ? found_weight(pt, st, pe) : 1.0f;
+}
+
 /* An index-matched boundary: the medium on the far side, the same direction. */
 static int cross_boundary(const murk_pt *pt, path *st, const murk_hit *hit)
 {
@@ -736,7 +771,7 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
             }
         }
         if (!found) {
-            add_light(&st, h->background(scene, st.ray.d), 1.0f, MURK_PT_TERM_BACKGROUND);
+            add_light(&st, h->background(scene, st.ray.d), escaped_weight(pt, scene, &st), MURK_PT_TERM_BACKGROUND);
             PT_TAP_END(&st, MURK_PT_END_ESCAPED);
             break;
         }

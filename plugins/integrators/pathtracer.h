@@ -23,7 +23,12 @@
  * With nee = 1 every scattering vertex (surface or medium) also samples a light point and estimates
  * the transmittance to it (murk_pt_shadow); the light sample and the BSDF / phase sample are weighted
  * by the power heuristic on their solid-angle pdfs (unbiased: the weights depend on the direction
- * only and sum to 1). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
+ * only and sum to 1). A light at infinity (a distant light, the environment: dist = INFINITY) is
+ * reached by a shadow ray that runs to infinity along its direction (murk_pt_shadow_inf); a delta light
+ * (point, spot, delta distant) counts with weight 1, since no BSDF or phase sample can hit it. A ray that
+ * leaves the scene after a BSDF / phase sample adds background() weighted by the power heuristic
+ * against environment_pdf(), the pdf with which light sampling picks its direction (1 where none can:
+ * a constant background, which light sampling leaves out). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
  * independent estimator of the same image. With media = 0 (`path`) media are ignored and boundaries
  * passed straight through, by paths and shadow rays alike. Russian roulette after rr_depth events on
  * the path's largest channel weight over mean(R), relative to rr_threshold; survivors are divided by
@@ -69,6 +74,10 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
  * Every leg is aimed at q itself and stops 1e-4 max(1, |q|_inf) short of it. */
 murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
                         const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
+
+/* The same towards a light at infinity in direction wi: every leg keeps wi and runs to infinity. */
+murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 wi,
+                            const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
 
 /* The techniques the path tracer tells apart, one for each contribution it makes to a sample (its
  * `term`): light sampling at a surface vertex, at a free-flight medium vertex and at the equiangular

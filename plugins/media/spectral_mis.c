@@ -112,7 +112,7 @@ static MURK_ALWAYS_INLINE void smis_flight(const smis *sm, const murk_ray *ray, 
     if (!(m->smax > 0.0f))
         return;
     int emit = fields && murk_emitting(m);
-    int np = fields && m->d->integrator_minor >= MURK_ABI_FIELDS_MINOR && (ctx->flags & MURK_CTX_NULL_PROB) && !sm->closed_form;
+    int np = fields && m->d->integrator_minor >= MURK_ABI_MINOR_FIELDS && (ctx->flags & MURK_CTX_NULL_PROB) && !sm->closed_form;
     if (np)
         ev->null_prob = 1.0f; /* the product of the hero's null probabilities, for volpath_nee's nee_mis */
     murk_ray rest = *ray;
@@ -164,7 +164,7 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
                         murk_medium_event *ev)
 {
     const smis *m = self;
-    if (m->base.fields || (m->base.d->integrator_minor >= MURK_ABI_FIELDS_MINOR && (ctx->flags & MURK_CTX_NULL_PROB)))
+    if (m->base.fields || (m->base.d->integrator_minor >= MURK_ABI_MINOR_FIELDS && (ctx->flags & MURK_CTX_NULL_PROB)))
         smis_flight(m, ray, ctx, rng, ev, 1);
     else
         smis_flight(m, ray, ctx, rng, ev, 0);

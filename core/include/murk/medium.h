@@ -67,14 +67,14 @@ typedef struct murk_medium_data {
      * murk_rng_float, as trackers built before it do. murk/tracking.h's murk_flight_* helpers and
      * murk_collisions do this. */
     int stratify_flights;
-    /* ABI 1.8 (read them only if MURK_HAS(size, murk_medium_data, integrator_minor)): */
+    /* ABI 1.9 (read them only if MURK_HAS(size, murk_medium_data, integrator_minor)): */
     uint32_t fields;           /* MURK_FIELD_*: the medium's fields beside density (below) */
-    uint32_t integrator_minor; /* the ABI minor of the scene's integrator: >= MURK_ABI_FIELDS_MINOR means it passes a
+    uint32_t integrator_minor; /* the ABI minor of the scene's integrator: >= MURK_ABI_MINOR_FIELDS means it passes a
                                 * murk_medium_event with `emitted` and `null_prob` and a murk_path_ctx with
                                 * `pdf_ratio` and `flags`; a tracker writes or reads those only then */
 } murk_medium_data;
 
-/* Fields beside density (ABI 1.8), the scene's `albedo`, `emission` and `temperature` keys. Where a
+/* Fields beside density (ABI 1.9), the scene's `albedo`, `emission` and `temperature` keys. Where a
  * medium has none of them (fields == 0), sigma_a and sigma_s are the constants above, everywhere.
  *   MURK_FIELD_ALBEDO    the single-scattering albedo varies in space: host->albedo(density, p) = a(p)
  *                        per channel, and at p  sigma_s(p) = a(p) sigma_t(p),
@@ -84,8 +84,8 @@ typedef struct murk_medium_data {
  *                        absorption, so the source term is sigma_a(p) Le(p) per unit length (temperature
  *                        fields arrive here as blackbody radiance). A tracker collects it along its free
  *                        flights into ev->emitted (murk/tracking.h: murk_emit).
- * murk refuses a medium with fields whose tracker was built before ABI 1.8 (it would ignore them), and
- * emission with an integrator built before 1.8 (it would not collect it). */
+ * murk refuses a medium with fields whose tracker was built before ABI 1.9 (it would ignore them), and
+ * emission with an integrator built before 1.9 (it would not collect it). */
 enum { MURK_FIELD_ALBEDO = 1u, MURK_FIELD_EMISSION = 2u };
 
 /* A walk over the majorant grid along a ray: consecutive segments [ta, tb) that tile the range given
@@ -99,7 +99,7 @@ typedef struct murk_medium_event {
     float t;            /* where it scattered (ray->tmax when it passed) */
     murk_rgb weight;    /* multiply into the path's beta (all 0: absorbed, the path ends) */
     murk_rgb pdf_ratio; /* multiply into the path's pdf ratios R: (1,1,1) except for per-channel trackers */
-    /* ABI 1.8 (only if the medium data's integrator_minor >= MURK_ABI_FIELDS_MINOR; the integrator sets emitted to 0 and
+    /* ABI 1.9 (only if the medium data's integrator_minor >= MURK_ABI_MINOR_FIELDS; the integrator sets emitted to 0 and
      * null_prob to -1 before sample()): */
     murk_rgb emitted;   /* the radiance the flight collected from an emitting medium, which the integrator
                          * credits as beta * emitted / mean(R) with the path's beta and R before this flight
@@ -113,7 +113,7 @@ typedef struct murk_medium_event {
 typedef struct murk_path_ctx {
     int hero;        /* channel 0..2 chosen uniformly per path */
     murk_rgb beta;   /* the path's weight so far (history-aware probabilities use it) */
-    /* ABI 1.8 (only if the medium data's integrator_minor >= MURK_ABI_FIELDS_MINOR): */
+    /* ABI 1.9 (only if the medium data's integrator_minor >= MURK_ABI_MINOR_FIELDS): */
     murk_rgb pdf_ratio; /* the path's pdf ratios R so far (murk_emit needs them for spectral MIS) */
     uint32_t flags;     /* MURK_CTX_*: what the integrator asks of this flight */
 } murk_path_ctx;

@@ -1,4 +1,4 @@
-/* murk/phase.h — the phase-function plugin interface (ABI 1.8).
+/* murk/phase.h — the phase-function plugin interface (ABI 1.9).
  *
  * A medium scatters light with a phase function p(wo, wi): the probability density (per steradian) that
  * light arriving at a scattering point and leaving it towards wo came from direction wi. Both point away
@@ -45,7 +45,7 @@ typedef struct murk_phase_vt {
     double (*mean_cosine)(const void *self); /* may be NULL */
 } murk_phase_vt;
 
-#define MURK_PHASE_VT_SIZE_1_8 (offsetof(murk_phase_vt, mean_cosine) + sizeof(void (*)(void)))
+#define MURK_PHASE_VT_SIZE_1_9 (offsetof(murk_phase_vt, mean_cosine) + sizeof(void (*)(void)))
 #define MURK_PHASE_PLUGIN(NAME, DESCRIPTION, PARAMS, NPARAMS, VT)                                  \
     MURK_DEFINE_PLUGIN_(MURK_KIND_PHASE, NAME, DESCRIPTION, PARAMS, NPARAMS,                       \
                         _Generic((VT), const murk_phase_vt *: (VT), murk_phase_vt *: (VT)))

@@ -37,7 +37,7 @@ typedef struct murk_tracker {
     float smax;       /* its largest channel */
     int grey;         /* 1 if sigma_t is the same in every channel */
     const char *plugin; /* the tracker's name for the watchdog's reports; set it after murk_tracker_new */
-    uint32_t fields;  /* the medium's fields beside density (MURK_FIELD_*, murk/medium.h; 0 before ABI 1.8) */
+    uint32_t fields;  /* the medium's fields beside density (MURK_FIELD_*, murk/medium.h; 0 before ABI 1.9) */
 } murk_tracker;
 
 /* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
@@ -321,7 +321,7 @@ static MURK_ALWAYS_INLINE int murk_collisions_next(murk_collisions *c, murk_rng 
  * coordinate, else the PCG stream's. Draw it with this, not murk_rng_float. */
 static MURK_ALWAYS_INLINE float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
 
-/* ---- Fields beside density (ABI 1.8; murk/medium.h) ---------------------------------------------------
+/* ---- Fields beside density (ABI 1.9; murk/medium.h) ---------------------------------------------------
  * A medium with an albedo field or emission (t->fields != 0) needs more per collision than one without, so
  * murk's trackers write their collision loop once as a MURK_ALWAYS_INLINE function with a constant flag
  * and call it twice: the instance without fields is the loop as it always was (no lookups, no branches
@@ -346,7 +346,7 @@ static MURK_ALWAYS_INLINE float murk_collisions_choice(murk_collisions *c, murk_
 /* 1 if the flight must collect emission: the medium emits and the integrator passes events that hold it. */
 static inline int murk_emitting(const murk_tracker *t)
 {
-    return (t->fields & MURK_FIELD_EMISSION) && t->d->integrator_minor >= MURK_ABI_FIELDS_MINOR;
+    return (t->fields & MURK_FIELD_EMISSION) && t->d->integrator_minor >= MURK_ABI_MINOR_FIELDS;
 }
 
 /* a / b, 0 where b is 0 (a local albedo where the density vanishes). */
