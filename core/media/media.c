@@ -114,7 +114,8 @@ float murk_media_phase_sample(const murk_medium *m, murk_vec3 wo, const float u[
     return *pdf;
 }
 
-const murk_phase *murk_media_phase(const murk_medium *m) { return &m->data->density->phase; }
+/* Exported for libmurklab: murk check calls a phase plugin through it (lab/check/check.c). */
+MURK_API const murk_phase *murk_media_phase(const murk_medium *m) { return &m->data->density->phase; }
 
 murk_rgb murk_media_albedo(const murk_density *d, murk_vec3 p)
 {
