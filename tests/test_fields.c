@@ -14,6 +14,8 @@
  *   - bad input: negative or NaN emission / temperature / albedo, albedo above 1, temperature keys
  *     without a temperature, a tracker built before ABI 1.9 on a medium with fields: located errors,
  *     nothing written; density and temperature grids of different boxes and sizes are allowed;
+ *   - plugins of older minors: a 1.8 tracker on a medium without fields and a 1.7 integrator on a medium with
+ *     an albedo field render; the 1.7 integrator on an emitting medium is refused, located;
  *   - determinism: explosion.yaml (three trackers) and dense_cloud_sun.yaml give the same bits at 1 and 3
  *     threads. */
 #include "mediatest.h"
@@ -306,17 +308,25 @@ static void test_blackbody(void **state)
     murk_blackbody_table_free(&t);
 }
 
-static void expect_error(const char *name, const char *tracker, const char *keys, const char *what)
+/* A scene of one medium (tracker and keys) in a box, rendered by integrator; its file's path. */
+static const char *box_scene(const char *name, const char *integrator, const char *tracker, const char *keys)
 {
-    char text[2048], out_exr[512], *out;
+    char text[2048];
     snprintf(text, sizeof text,
              "murk: 1\nrender: { resolution: [8, 8], spp: 1 }\n"
              "camera: { from: [0, 0, 3], at: [0, 0, 0], up: [0, 1, 0], fov: 40 }\n"
-             "integrator: { type: volpath_nee }\n"
+             "integrator: { type: %s }\n"
              "media: { fire: { type: %s, density: { constant: 1 }, sigma_a: 1, %s } }\n"
-             "shapes:\n  - { type: box, min: [-0.5, -0.5, -0.5], max: [0.5, 0.5, 0.5], interior: fire }\n", tracker,
-             keys);
-    const char *path = write_tmp(name, text);
+             "shapes:\n  - { type: box, min: [-0.5, -0.5, -0.5], max: [0.5, 0.5, 0.5], interior: fire }\n",
+             integrator, tracker, keys);
+    return write_tmp(name, text);
+}
+
+static void expect_error_with(const char *name, const char *integrator, const char *tracker, const char *keys,
+                              const char *what)
+{
+    char out_exr[512], *out;
+    const char *path = box_scene(name, integrator, tracker, keys);
     snprintf(out_exr, sizeof out_exr, "%s.exr", path);
     unlink(out_exr);
     int rc = run_murk(&out, "render", path, "-o", out_exr, "--quiet", NULL);
@@ -328,6 +338,30 @@ static void expect_error(const char *name, const char *tracker, const char *keys
     assert_contains(out, what);
     assert_int_not_equal(access(out_exr, F_OK), 0);
     free(out);
+}
+
+static void expect_error(const char *name, const char *tracker, const char *keys, const char *what)
+{
+    expect_error_with(name, "volpath_nee", tracker, keys, what);
+}
+
+/* Plugins of the minors before fields still load: a tracker of ABI 1.8 on a medium without fields, an
+ * integrator of 1.7 on a medium with an albedo field (trackers apply it); the emission such an integrator
+ * could not collect is refused at the medium's emission key. */
+static void test_old_plugins(void **state)
+{
+    (void)state;
+    static const char *const ok[][3] = {{"old_tr.yaml", "volpath_nee", "old_tracker"},
+                                        {"old_int.yaml", "old_integrator", "delta"}};
+    static const char *const keys[] = {"sigma_s: 1", "sigma_s: 1, albedo: { cloud: { resolution: 8 } }"};
+    for (int i = 0; i < 2; i++) {
+        char out_exr[512];
+        const char *path = box_scene(ok[i][0], ok[i][1], ok[i][2], keys[i]);
+        snprintf(out_exr, sizeof out_exr, "%s.exr", path);
+        run_murk_ok((const char *const[]){"render", path, "-o", out_exr, "--quiet", NULL}, NULL);
+    }
+    expect_error_with("old_int_emit.yaml", "old_integrator", "delta", "emission: [1, 2, 3]",
+                      "before volume emission");
 }
 
 static void test_bad_input(void **state)
@@ -408,6 +442,7 @@ int main(void)
         cmocka_unit_test(test_albedo_grid_constant),
         cmocka_unit_test(test_blackbody),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_old_plugins),
         cmocka_unit_test(test_different_boxes),
         cmocka_unit_test(test_deterministic),
     };
