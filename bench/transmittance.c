@@ -178,7 +178,7 @@ static void bench_scene(const char *label, const char *path, const char *const *
         for (int i = 0; i < nseg; i++) {
             murk_rng rng;
             murk_rng_seed(&rng, 99, (uint64_t)i, (uint64_t)ei);
-            murk_path_ctx ctx = {0, murk_rgb1(1.0f)};
+            murk_path_ctx ctx = {.hero = 0, .beta = murk_rgb1(1.0f)};
             double sum[3] = {0}, sum2[3] = {0};
             nlookups = 0;
             double t0 = murk_now();

@@ -55,7 +55,7 @@ enum { G_TECH = NCELL, G_BOUNCE = G_TECH + MURK_PT_NTERMS, G_ALL = G_BOUNCE + NB
 
 static const char *const term_name[MURK_PT_NTERMS] = {"surface NEE",     "medium NEE",        "equiangular NEE",
                                                       "BSDF emission",   "phase emission",    "camera emission",
-                                                      "background"};
+                                                      "background",      "medium emission"};
 static const char *const end_name[MURK_PT_NENDS] = {"roulette", "max_depth", "absorbed", "escaped"};
 static const char *const bucket_name[NB] = {"0", "1", "2", "3", "4-7", "8+"};
 

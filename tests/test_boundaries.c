@@ -123,7 +123,7 @@ static void test_shadow(void **state)
             fail_msg("%s", err);
         const murk_medium *med = &s->media[0].m;
         for (int media = 1; media >= 0; media--) {
-            murk_pt pt = {murk_host_table(), 64, 3, 1, media, MURK_LIGHT_AREA, 1.0f, 0};
+            murk_pt pt = {murk_host_table(), 64, 3, 1, media, MURK_LIGHT_AREA, 1.0f, 0, 0};
             for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
                 const shadow_case *sc = &cases[c];
                 double d = inside_length(sc->p, sc->q), s1[3] = {0}, s2[3] = {0};
@@ -133,7 +133,7 @@ static void test_shadow(void **state)
                 for (int i = 0; i < N; i++) {
                     murk_rng rng;
                     murk_rng_seed(&rng, 77, c, (uint64_t)i);
-                    murk_path_ctx ctx = {i % 3, murk_rgb1(1.0f)};
+                    murk_path_ctx ctx = {.hero = i % 3, .beta = murk_rgb1(1.0f)};
                     murk_rgb T = murk_pt_shadow(&pt, s, p, n, q, sc->inside ? med : NULL, &ctx, &rng);
                     for (int k = 0; k < 3; k++) {
                         s1[k] += T.c[k];

@@ -33,7 +33,7 @@ static void slab_closed_form(void **state)
     uint64_t scattered = 0;
     for (int i = 0; i < n; i++) {
         murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
-        murk_path_ctx ctx = {0, murk_rgb1(1.0f)};
+        murk_path_ctx ctx = {.hero = 0, .beta = murk_rgb1(1.0f)};
         murk_medium_event ev;
         uint64_t before = murk_thread_counters[0].collisions;
         m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
@@ -102,7 +102,7 @@ static void collisions_match_lookups(void **state)
             double sum = 0, sum2 = 0;
             for (int i = 0; i < n; i++) {
                 murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
-                murk_path_ctx ctx = {mt_hero(&rng), murk_rgb1(1.0f)};
+                murk_path_ctx ctx = {.hero = mt_hero(&rng), .beta = murk_rgb1(1.0f)};
                 murk_medium_event ev;
                 uint64_t before = murk_thread_counters[e].collisions;
                 if (call == 0)

@@ -51,7 +51,7 @@ static int flights_stratified(const murk_medium *m, uint64_t seed, uint64_t pixe
     double *u = malloc((size_t)n * sizeof *u);
     assert_non_null(u);
     murk_ray ray = {{0.5f, 0.5f, 0}, {0, 0, 1}, 0.0f, INFINITY};
-    murk_path_ctx ctx = {0, {{1, 1, 1}}};
+    murk_path_ctx ctx = {.hero = 0, .beta = {{1, 1, 1}}};
     for (int i = 0; i < n; i++) {
         murk_rng r;
         murk_sampler_start(&r, MURK_SAMPLER_SOBOL, seed, pixel, (uint32_t)i);
@@ -177,7 +177,7 @@ static void test_one_slot(void **state)
     }
     murk_scene *s = mt_load_media("slot.yaml", common, "", ms, 2 * NTRACKERS);
     murk_ray ray = cc.ray;
-    murk_path_ctx ctx = {0, {{1, 1, 1}}};
+    murk_path_ctx ctx = {.hero = 0, .beta = {{1, 1, 1}}};
     for (int i = 0; i < 2 * NTRACKERS; i++) {
         long used = 0, draws = 0, maxslots = 0;
         for (uint32_t n = 0; n < 4000; n++) {

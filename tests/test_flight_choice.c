@@ -84,7 +84,7 @@ static void first_choices(const murk_medium *m, uint64_t seed, uint64_t pixel, u
         float u[2];
         murk_sample_2d(&peek, u); /* the slot's point: u[0] gives the first tentative collision */
         double t1 = -log1p(-(double)u[0]) / mu;
-        murk_path_ctx ctx = {i % 3, {{1, 1, 1}}};
+        murk_path_ctx ctx = {.hero = i % 3, .beta = {{1, 1, 1}}};
         murk_medium_event ev;
         m->vt->sample(m->self, &ray, &ctx, &r, &ev);
         assert_true(ev.scattered && isfinite(ev.t));
@@ -205,7 +205,7 @@ static void flight_stats(const murk_medium *m, const murk_ray *ray, const double
             murk_rng r;
             murk_sampler_start(&r, sampler, seed, (uint64_t)p * 7919u + 13u, (uint32_t)i);
             murk_sample_seek(&r, SLOTS[0]);
-            murk_path_ctx ctx = {i % 3, {{1, 1, 1}}};
+            murk_path_ctx ctx = {.hero = i % 3, .beta = {{1, 1, 1}}};
             murk_medium_event ev;
             m->vt->sample(m->self, ray, &ctx, &r, &ev);
             assert_true(isfinite(ev.t));

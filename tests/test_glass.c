@@ -76,7 +76,7 @@ static double se(const stats *st, int k)
 
 static stats furnace(const murk_scene *s, int nee, int media, long n, uint64_t seed)
 {
-    murk_pt pt = {murk_host_table(), 100000, 3, nee, media, MURK_LIGHT_AREA, 1.0f, 0}; /* light trapped by TIR must not be cut off */
+    murk_pt pt = {murk_host_table(), 100000, 3, nee, media, MURK_LIGHT_AREA, 1.0f, 0, 0}; /* light trapped by TIR must not be cut off */
     stats st = {{0}, {0}, 0};
     for (long i = 0; i < n; i++) {
         murk_rng rng;
@@ -276,7 +276,7 @@ static void test_slab(void **state)
                     if (integ == 0 && (t > 0 || inside)) /* path ignores media: once is enough */
                         continue;
                     int media = integ > 0;
-                    murk_pt pt = {murk_host_table(), 1000, 3, integ == 2, media, MURK_LIGHT_AREA, 1.0f, 0};
+                    murk_pt pt = {murk_host_table(), 1000, 3, integ == 2, media, MURK_LIGHT_AREA, 1.0f, 0, 0};
                     double th = (inside ? inside_deg[a] : outside_deg[a]) * PI / 180.0;
                     murk_ray ray = {murk_v3((float)sin(th), 0, 0), murk_v3((float)sin(th), (float)cos(th), 0), 0.0f, INFINITY};
                     ray.o = inside ? murk_v3(0, 0.25f, 0) : murk_v3(0, -1, 0);

@@ -21,8 +21,8 @@
 #define STR_(x) #x
 #define STR(x) STR_(x)
 #define MINOR STR(MURK_ABI_MINOR)
-_Static_assert(MURK_ABI_MINOR == 8, "update MINOR_PLUS_1 with the ABI minor");
-#define MINOR_PLUS_1 "9"
+_Static_assert(MURK_ABI_MINOR == 9, "update MINOR_PLUS_1 with the ABI minor");
+#define MINOR_PLUS_1 "10"
 
 static char err[2048];
 

@@ -226,7 +226,7 @@ static void t_tracker_progress_and_watchdog(void **state)
     h.walk_init = fake_walk_init;
     h.walk_next = fake_walk_next;
     h.warn_once = fake_warn_once;
-    murk_medium_data d = {sizeof d, murk_rgb1(0.0f), murk_rgb1(1e10f), 0.0f, NULL, "m", 0};
+    murk_medium_data d = {sizeof d, murk_rgb1(0.0f), murk_rgb1(1e10f), 0.0f, NULL, "m", 0, 0, 0};
     char err[128];
     murk_tracker *t = murk_tracker_new(&h, &d, sizeof *t, err, sizeof err);
     assert_non_null(t);

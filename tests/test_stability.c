@@ -47,7 +47,7 @@ static int same_events(const murk_medium *a, const murk_medium *b, const murk_ra
     murk_rng ra, rb;
     murk_rng_seed(&ra, 99, 1, 2);
     murk_rng_seed(&rb, 99, 1, 2);
-    murk_path_ctx ca = {0, murk_rgb1(1.0f)}, cb = ca;
+    murk_path_ctx ca = {.hero = 0, .beta = murk_rgb1(1.0f)}, cb = ca;
     for (long i = 0; i < n; i++) {
         ca.hero = cb.hero = (int)(i % 3);
         murk_rgb Ta = a->vt->transmittance(a->self, ray, &ca, &ra), Tb = b->vt->transmittance(b->self, ray, &cb, &rb);

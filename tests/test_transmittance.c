@@ -439,7 +439,7 @@ static void test_raymarch_bias(void **state)
                 murk_ray ray = {o, d, 0.0f, 3.5f};
                 double T = exp(-4.0 * mt_quadrature(&s->media[0].m, &ray));
                 for (int i = 0; i < NS; i++) {
-                    murk_path_ctx ctx = {0, murk_rgb1(1.0f)};
+                    murk_path_ctx ctx = {.hero = 0, .beta = murk_rgb1(1.0f)};
                     murk_rgb e = murk_medium_transmittance(&s->media[i].m, &ray, &ctx, &rng);
                     sq[i] += pow((e.c[0] - T) / T, 2);
                 }

@@ -23,11 +23,22 @@ static const special_key density_key = {
     .type = "map",
     .doc = "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }",
 };
-static const special_key transmittance_key = {
-    .name = "transmittance",
-    .type = "name",
-    .doc = "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)",
+/* after the schema's keys */
+static const special_key tail_keys[] = {
+    {"transmittance", "name", "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)"},
+    {"phase", "name", "phase function: NAME or { type: NAME, ... } (hg, isotropic, draine, hg_draine, rayleigh; "
+                      "default: Henyey-Greenstein of g)"},
+    {"albedo", "rgb|map", "single-scattering albedo in [0, 1]: [r, g, b] (sets the split of sigma_a and sigma_s, "
+                          "their sum kept) or a field { grid: FILE.vol (1 or 3 channels)|FILE.nvdb } | { cloud: "
+                          "{ ... } }: sigma_s(p) = albedo(p) sigma_t(p)"},
+    {"emission", "rgb|map", "radiance emitted per unit absorption (the medium emits sigma_a(p) Le(p)): [r, g, b] or a "
+                            "field { grid: ... } | { cloud: { ... } }; with a temperature it scales the blackbody "
+                            "radiance (default 1)"},
+    {"temperature", "map", "kelvin, (value - temperature_offset) x temperature_scale: { grid: ... } | { constant: "
+                           "V } | { cloud: { ... } }; blackbody emission (Planck, CIE 1931, linear sRGB, normalised "
+                           "to its peak as pbrt-v4)"},
 };
+#define NTAIL (sizeof tail_keys / sizeof tail_keys[0])
 
 static const char *type_name(uint32_t t)
 {
@@ -108,7 +119,8 @@ static void medium_keys_text(void)
     printf("  medium keys (read by the core, for every tracker):\n");
     print_key(&density_key);
     print_params(murk_medium_core_params, MURK_MEDIUM_NCORE);
-    print_key(&transmittance_key);
+    for (size_t i = 0; i < NTAIL; i++)
+        print_key(&tail_keys[i]);
 }
 
 /* keys: whether a medium's section lists the medium keys (--all lists them once, before the first) */
@@ -122,6 +134,8 @@ static void describe_text(const murk_plugin *p, int keys)
     if (d->kind == MURK_KIND_TRANSMITTANCE)
         printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name,
                d->name);
+    if (d->kind == MURK_KIND_PHASE)
+        printf("  a medium selects it with `phase: %s` (or { type: %s, ... })\n", d->name, d->name);
     if (!d->nparams) {
         printf("  no parameters of its own\n");
         return;
@@ -155,7 +169,7 @@ static void md_row(const char *name, const char *type, const char *def, const ch
     fputs(" |\n", stdout);
 }
 
-static void md_params(const murk_param *ps, uint32_t n, const special_key *first, const special_key *last)
+static void md_params(const murk_param *ps, uint32_t n, const special_key *first, const special_key *last, size_t nlast)
 {
     printf("| parameter | type | default | range | what |\n|---|---|---|---|---|\n");
     if (first)
@@ -168,13 +182,13 @@ static void md_params(const murk_param *ps, uint32_t n, const special_key *first
                  (q->flags & MURK_PARAM_TEXTURABLE) ? " or texture" : "");
         md_row(q->name, type, (q->flags & MURK_PARAM_REQUIRED) ? "required" : def, range, q->doc);
     }
-    if (last)
-        md_row(last->name, last->type, "", "", last->doc);
+    for (size_t i = 0; i < nlast; i++)
+        md_row(last[i].name, last[i].type, "", "", last[i].doc);
 }
 
 static void medium_keys_md(void)
 {
-    md_params(murk_medium_core_params, MURK_MEDIUM_NCORE, &density_key, &transmittance_key);
+    md_params(murk_medium_core_params, MURK_MEDIUM_NCORE, &density_key, tail_keys, NTAIL);
 }
 
 static void describe_md(const murk_plugin *p, int keys)
@@ -184,8 +198,10 @@ static void describe_md(const murk_plugin *p, int keys)
     if (d->kind == MURK_KIND_TRANSMITTANCE)
         printf("A medium selects it with `transmittance: %s` (or `{ type: %s, ... }`) beside its tracker.\n\n",
                d->name, d->name);
+    if (d->kind == MURK_KIND_PHASE)
+        printf("A medium selects it with `phase: %s` (or `{ type: %s, ... }`).\n\n", d->name, d->name);
     if (d->nparams) {
-        md_params(d->params, d->nparams, NULL, NULL);
+        md_params(d->params, d->nparams, NULL, NULL, 0);
         putchar('\n');
     } else {
         printf("No parameters of its own.\n\n");
@@ -279,10 +295,11 @@ static void list_text_one(void *ctx, const char *file, const char *path, murk_pl
     }
 }
 
-/* the order of the docs: materials, media, transmittance estimators, integrators; by name within */
+/* the order of the docs: materials, media, transmittance estimators, phase functions, integrators; by name within */
 static int kind_rank(uint32_t kind)
 {
-    return kind == MURK_KIND_MATERIAL ? 0 : kind == MURK_KIND_MEDIUM ? 1 : kind == MURK_KIND_TRANSMITTANCE ? 2 : 3;
+    return kind == MURK_KIND_MATERIAL ? 0 : kind == MURK_KIND_MEDIUM ? 1 : kind == MURK_KIND_TRANSMITTANCE ? 2
+           : kind == MURK_KIND_PHASE ? 3 : 4;
 }
 
 static int by_kind_and_name(const void *a, const void *b)

@@ -572,7 +572,9 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     if (load_materials(s, host, murk_ymap_get(root, "materials"), err, errlen))
         return -1;
-    if (load_integrator(s, host, murk_ymap_get(root, "integrator"), err, errlen))
+    if (load_integrator(s, host, murk_ymap_get(root, "integrator"), err, errlen) ||
+        murk_media_bind_integrator(s, murk_ymap_get(root, "media"), s->integrator_plugin->desc->name,
+                                   s->integrator_plugin->abi.minor, err, errlen))
         return -1;
     /* an integrator built before the lights' ABI gets only emissive shapes to sample (render/lights.h) */
     s->legacy_lights = s->integrator_plugin->abi.minor < MURK_ABI_MINOR_LIGHTS;
@@ -623,9 +625,11 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
     for (size_t i = 0; shapes && shapes->kind == MURK_Y_SEQ && i < shapes->n; i++) /* meshes */
         if (names(shapes->items[i], "type", "mesh") && hash_input(s, murk_ymap_get(shapes->items[i], "file"), &h, err, errlen))
             return 0;
-    for (size_t i = 0; media && i < media->n; i++) /* density grids */
-        if (hash_input(s, murk_ymap_get(murk_ymap_get(media->items[i], "density"), "grid"), &h, err, errlen))
-            return 0;
+    static const char *const grids[] = {"density", "albedo", "emission", "temperature"};
+    for (size_t i = 0; media && i < media->n; i++) /* density, albedo, emission and temperature grids */
+        for (size_t g = 0; g < NKEYS(grids); g++)
+            if (hash_input(s, murk_ymap_get(murk_ymap_get(media->items[i], grids[g]), "grid"), &h, err, errlen))
+                return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;
     const murk_ynode *lights = murk_ymap_get(root, "lights");

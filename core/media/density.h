@@ -51,6 +51,10 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen);
 /* Writes a grid field as a 1-channel float32 .vol (temporary file + rename); -1 on error (also for a
  * constant field, which has no grid). A saved-then-loaded field is bitwise identical. */
 int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen);
+/* An RGB grid from a .vol of 1 channel (grey: out[0] = out[1] = out[2], one field) or 3 channels (three
+ * fields, one per channel, each checked like a density grid). Returns the file's channel count, or -1
+ * with err (out[] NULL). */
+int murk_field_vol_load3(const char *path, murk_field *out[3], char *err, size_t errlen);
 murk_field *murk_field_nvdb_load(const char *path, char *err, size_t errlen);
 /* fBm cloud in [lo, hi]: res^3 voxels (2..1024), frequency in features per box width (> 0),
  * octaves 1..16, coverage in [0, 1] (larger fills more of the box). Deterministic for a seed; the
@@ -105,5 +109,39 @@ typedef struct murk_dda {
 void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, float t0, float t1);
 /* Returns 1 and fills the outputs (any may be NULL) for the next segment, 0 when done. */
 int murk_dda_next(murk_dda *it, float *ta, float *tb, float *maj, float *min);
+
+/* ---- Blackbody emission (blackbody.c) -------------------------------------------------------------
+ * Planck's law at temperature T (kelvin), normalised to its peak (as pbrt-v4), integrated against the CIE
+ * 1931 2-degree colour-matching functions (5 nm, 360..830 nm) over the integral of ybar: CIE XYZ; then
+ * linear sRGB (D65), negative channels set to 0. T <= 0 or not finite: black. */
+void murk_blackbody_xyz(double T, double xyz[3]);
+/* Row i (360 + 5 i nm, i in [0, 94]) of the CIE 1931 table blackbody.c integrates with: xbar, ybar, zbar. */
+void murk_cie1931(int i, double cmf[3]);
+murk_rgb murk_blackbody_rgb(double T);
+
+/* murk_blackbody_rgb tabulated over [0, tmax] in n equal steps (at most 1 K apart, at most
+ * MURK_BLACKBODY_TABLE_MAX + 1 entries), linearly interpolated by murk_blackbody_lookup and clamped at
+ * tmax: what a temperature field's lookups use. */
+#define MURK_BLACKBODY_TABLE_MAX 65536
+typedef struct murk_blackbody_table {
+    int n;
+    float step, inv_step;
+    murk_rgb *rgb; /* n + 1 entries (the last repeated) */
+} murk_blackbody_table;
+int murk_blackbody_table_build(murk_blackbody_table *t, double tmax); /* -1: out of memory */
+void murk_blackbody_table_free(murk_blackbody_table *t);
+
+static inline murk_rgb murk_blackbody_lookup(const murk_blackbody_table *t, float T)
+{
+    float x = T * t->inv_step;
+    if (!(x > 0.0f))
+        return t->rgb[0];
+    if (x >= (float)(t->n - 1))
+        return t->rgb[t->n - 1];
+    int i = (int)x;
+    float w = x - (float)i;
+    murk_rgb a = t->rgb[i], b = t->rgb[i + 1];
+    return murk_rgb3(a.c[0] + w * (b.c[0] - a.c[0]), a.c[1] + w * (b.c[1] - a.c[1]), a.c[2] + w * (b.c[2] - a.c[2]));
+}
 
 #endif

@@ -20,12 +20,15 @@
  *       ...                         # the tracker's own parameters */
 #include "media/media.h"
 #include "media/density.h"
+#include "media/fields.h"
 #include "scene/params.h"
 #include "scene/scene.h"
 #include "util/limit.h"
 #include "util/runtime.h"
 #include "util/util.h"
 #include "yaml/yread.h"
+
+#include "murk/phase.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -37,6 +40,8 @@ struct murk_density {
     murk_bound_grid grid;
     float factor;
     unsigned slot; /* its medium's cost counters (runtime.h) */
+    murk_phase phase;         /* the `phase:` plugin; vt NULL: Henyey-Greenstein of the medium's g */
+    murk_medium_fields fields; /* albedo, emission, temperature (fields.h) */
 };
 
 MURK_API void murk_density_parts(const murk_density *d, const murk_field **field, const murk_bound_grid **grid,
@@ -86,29 +91,42 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     return r;
 }
 
-float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi)
-{
-    float cost = murk_dot(wo, wi);
-    float denom = 1.0f + g * g + 2.0f * g * cost;
-    return (1.0f / (4.0f * MURK_PI)) * (1.0f - g * g) / (denom * sqrtf(fmaxf(denom, 1e-12f)));
-}
+float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi) { return murk_hg_eval(g, wo, wi); }
 
 murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf)
 {
-    float cost;
-    if (fabsf(g) < 1e-3f) {
-        cost = 1.0f - 2.0f * u[0];
-    } else {
-        float sq = (1.0f - g * g) / (1.0f + g - 2.0f * g * u[0]);
-        cost = -(1.0f + g * g - sq * sq) / (2.0f * g);
-    }
-    cost = fminf(1.0f, fmaxf(-1.0f, cost));
-    float sint = sqrtf(fmaxf(0.0f, 1.0f - cost * cost)), phi = 2.0f * MURK_PI * u[1];
-    murk_vec3 t, b;
-    murk_basis(wo, &t, &b);
-    murk_vec3 wi = murk_normalize(murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, wo));
-    *pdf = murk_phase_hg_eval(g, wo, wi);
-    return wi;
+    return murk_hg_sample(g, wo, u, pdf);
+}
+
+/* A medium's phase function: its plugin, else Henyey-Greenstein of its g (the same bits as above). */
+float murk_media_phase_eval(const murk_medium *m, murk_vec3 wo, murk_vec3 wi)
+{
+    const murk_phase *ph = &m->data->density->phase;
+    return ph->vt ? ph->vt->eval(ph->self, wo, wi) : murk_hg_eval(m->data->g, wo, wi);
+}
+
+float murk_media_phase_sample(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf)
+{
+    const murk_phase *ph = &m->data->density->phase;
+    if (ph->vt)
+        return ph->vt->sample(ph->self, wo, u, wi, pdf);
+    *wi = murk_hg_sample(m->data->g, wo, u, pdf);
+    return *pdf;
+}
+
+/* Exported for libmurklab: murk check calls a phase plugin through it (lab/check/check.c). */
+MURK_API const murk_phase *murk_media_phase(const murk_medium *m) { return &m->data->density->phase; }
+
+murk_rgb murk_media_albedo(const murk_density *d, murk_vec3 p)
+{
+    murk_thread_counters[d->slot].lookups++;
+    return murk_fields_albedo(&d->fields, p);
+}
+
+murk_rgb murk_media_emission(const murk_density *d, murk_vec3 p)
+{
+    murk_thread_counters[d->slot].lookups++;
+    return murk_fields_emission(&d->fields, p);
 }
 
 /* ---- scene loading ------------------------------------------------------------------------- */
@@ -150,25 +168,29 @@ static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
     return f;
 }
 
-static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *err, size_t errlen)
+murk_field *murk_media_scalar_field(const murk_scene *s, const murk_ynode *d, const char *what, char *err,
+                                    size_t errlen)
 {
     static const char *const keys[] = {"constant", "grid", "cloud"};
     if (d->kind != MURK_Y_MAP || d->n != 1) {
-        murk_yerr(err, errlen, d, "density must be one of { constant: V }, { grid: FILE.vol|FILE.nvdb }, { cloud: {...} }");
+        murk_yerr(err, errlen, d, "%s must be one of { constant: V }, { grid: FILE.vol|FILE.nvdb }, { cloud: {...} }",
+                  what);
         return NULL;
     }
-    if (murk_ycheck_keys(d, "density", keys, 3, err, errlen))
+    if (murk_ycheck_keys(d, what, keys, 3, err, errlen))
         return NULL;
     const murk_ynode *k;
+    char label[96];
     if ((k = murk_ymap_get(d, "constant"))) {
         double v;
-        if (murk_yread_range(k, "density.constant", 0, 1e30, &v, err, errlen))
+        snprintf(label, sizeof label, "%s.constant", what);
+        if (murk_yread_range(k, label, 0, 1e30, &v, err, errlen))
             return NULL;
         return murk_field_constant((float)v);
     }
     if ((k = murk_ymap_get(d, "grid"))) {
         if (k->kind != MURK_Y_SCALAR || !*k->str) {
-            murk_yerr(err, errlen, k, "density.grid must be a file name");
+            murk_yerr(err, errlen, k, "%s.grid must be a file name", what);
             return NULL;
         }
         char *path = murk_path_relative_to(s->doc.file, k->str);
@@ -178,7 +200,7 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
                                                                         : murk_field_vol_load(path, ferr, sizeof ferr);
         free(path);
         if (!f)
-            murk_yerr(err, errlen, k, "density grid: %s", ferr);
+            murk_yerr(err, errlen, k, "%s grid: %s", what, ferr);
         return f;
     }
     return load_cloud(murk_ymap_get(d, "cloud"), err, errlen);
@@ -188,12 +210,14 @@ static murk_field *load_density(const murk_scene *s, const murk_ynode *d, char *
  * plugin's parameters, and listed with them by `murk plugins TRACKER`. `density` and `transmittance`
  * (maps or names) are read separately (murk_medium_special_keys). */
 enum { K_SIGMA_A, K_SIGMA_S, K_SCALE, K_G, K_MAJORANT_FACTOR, K_MAJORANT_RESOLUTION, K_MAJORANT_REPAIR,
-       K_STRATIFY_FLIGHTS, K_COUNT };
+       K_STRATIFY_FLIGHTS, K_TEMPERATURE_SCALE, K_TEMPERATURE_OFFSET, K_COUNT };
 MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
     [K_SIGMA_A] = {"sigma_a", MURK_PARAM_RGB, 0, {0, 0, 0}, NULL, NULL, 0, 1e8, "absorption per unit density"},
     [K_SIGMA_S] = {"sigma_s", MURK_PARAM_RGB, 0, {1, 1, 1}, NULL, NULL, 0, 1e8, "scattering per unit density"},
     [K_SCALE] = {"scale", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 1e8, "multiplies sigma_a and sigma_s"},
-    [K_G] = {"g", MURK_PARAM_FLOAT, 0, {0, 0, 0}, NULL, NULL, -0.99, 0.99, "Henyey-Greenstein asymmetry"},
+    [K_G] = {"g", MURK_PARAM_FLOAT, 0, {0, 0, 0}, NULL, NULL, -0.99, 0.99,
+             "Henyey-Greenstein asymmetry of the default phase function; an error beside a phase: block (give hg's g "
+             "there)"},
     [K_MAJORANT_FACTOR] = {"majorant_factor", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 1e-3, 1e3,
                            "multiplies the majorant grid; < 1 no longer bounds (repaired, see majorant_repair)"},
     [K_MAJORANT_RESOLUTION] = {"majorant_resolution", MURK_PARAM_INT, 0, {16, 0, 0}, NULL, NULL, 1, 256,
@@ -204,8 +228,15 @@ MURK_API const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE] = {
     [K_STRATIFY_FLIGHTS] = {"stratify_flights", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
                             "a free flight's first distance and collision choice from the sampler (stratified over "
                             "a pixel's samples with render.sampler: sobol); false: all from the PCG stream"},
+    [K_TEMPERATURE_SCALE] = {"temperature_scale", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 1e6,
+                             "kelvin per unit of the temperature field: T = (value - temperature_offset) x "
+                             "temperature_scale"},
+    [K_TEMPERATURE_OFFSET] = {"temperature_offset", MURK_PARAM_FLOAT, 0, {0, 0, 0}, NULL, NULL, -1e6, 1e6,
+                              "subtracted from the temperature field's values before temperature_scale; "
+                              "temperatures at or below 0 K emit nothing"},
 };
-MURK_API const char *const murk_medium_special_keys[2] = {"density", "transmittance"};
+MURK_API const char *const murk_medium_special_keys[MURK_MEDIUM_NSPECIAL] = {"density", "transmittance", "phase",
+                                                                            "albedo", "emission", "temperature"};
 
 /* Keys of the block that the core's schema does not read: "type", the special keys and the tracker's
  * own parameters. */
@@ -213,7 +244,7 @@ static size_t skip_keys(const murk_plugin_desc *d, const char **out, size_t cap)
 {
     size_t n = 0;
     out[n++] = "type";
-    for (size_t i = 0; i < 2; i++)
+    for (size_t i = 0; i < MURK_MEDIUM_NSPECIAL; i++)
         out[n++] = murk_medium_special_keys[i];
     for (uint32_t i = 0; d && i < d->nparams && n < cap; i++)
         out[n++] = d->params[i].name;
@@ -240,6 +271,60 @@ static int load_estimator(murk_scene *s, const murk_host *host, const char *name
     nm->m.tr_vt = p->desc->vtable;
     nm->tr_plugin = p;
     return 0;
+}
+
+/* `phase: NAME` or `phase: { type: NAME, key: value, ... }`: the medium's phase-function plugin (murk/phase.h),
+ * its parameters checked against its schema. */
+static int load_phase(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *n, murk_phase *ph,
+                      char *err, size_t errlen)
+{
+    static const char *const skip[] = {"type"};
+    const murk_ynode *t = n->kind == MURK_Y_MAP ? murk_ymap_get(n, "type") : n;
+    if (!t || t->kind != MURK_Y_SCALAR || !*t->str)
+        return murk_yerr(err, errlen, t ? t : n, "medium '%s': phase must be a phase function's name or "
+                         "{ type: NAME, ... } (murk plugins lists the phase kind: hg, isotropic, draine, hg_draine, "
+                         "rayleigh)", name);
+    char block[256], who[256];
+    snprintf(block, sizeof block, "medium '%s': phase", name);
+    snprintf(who, sizeof who, "medium '%s' phase (%s)", name, t->str);
+    const murk_plugin *p;
+    if (murk_scene_instantiate(s, host, MURK_KIND_PHASE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP, NULL,
+                               &p, &ph->self, err, errlen))
+        return -1;
+    ph->vt = p->desc->vtable;
+    return 0;
+}
+
+/* The medium's phase function and fields beside density, after its core keys (core[]). */
+static int load_extras(murk_scene *s, const murk_host *host, const char *name, const char *who, const murk_ynode *m,
+                       const murk_value *core, murk_named_medium *nm, char *err, size_t errlen)
+{
+    const murk_ynode *pn = murk_ymap_get(m, "phase");
+    if (pn && core[K_G].set) {
+        const murk_ynode *gn = murk_ymap_get(m, "g");
+        return murk_yerr(err, errlen, gn ? gn : pn, "%s: 'g' beside a phase: block (the phase function's own "
+                         "parameters say it: phase: { type: hg, g: ... })", who);
+    }
+    if (pn && load_phase(s, host, name, pn, &nm->density->phase, err, errlen))
+        return -1;
+    int t_set = core[K_TEMPERATURE_SCALE].set || core[K_TEMPERATURE_OFFSET].set;
+    return murk_fields_load(s, m, who, core[K_TEMPERATURE_SCALE].f[0], core[K_TEMPERATURE_OFFSET].f[0], t_set,
+                            &nm->density->fields, &nm->data, err, errlen);
+}
+
+/* A tracker built before ABI 1.9 knows nothing of albedo or emission fields: it would render the medium
+ * without them. */
+static int check_tracker_fields(const murk_plugin *p, const murk_medium_data *md, const murk_ynode *m,
+                                const char *who, char *err, size_t errlen)
+{
+    if (!md->fields || p->abi.minor >= MURK_ABI_MINOR_FIELDS)
+        return 0;
+    const murk_ynode *at = murk_ymap_get(m, md->fields & MURK_FIELD_ALBEDO ? "albedo" : "emission");
+    if (!at)
+        at = murk_ymap_get(m, "temperature");
+    return murk_yerr(err, errlen, at ? at : m, "%s: tracker '%s' was built for plugin ABI %u.%u, before albedo and "
+                     "emission fields (1.%d), and would ignore them; rebuild it, or use one of murk's trackers", who,
+                     p->desc->name, p->abi.major, p->abi.minor, MURK_ABI_MINOR_FIELDS);
 }
 
 static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m,
@@ -282,7 +367,7 @@ static int load_medium(murk_scene *s, const murk_host *host, const char *name, c
     const murk_ynode *dn = murk_ymap_get(m, "density");
     nm->density = murk_xmalloc(sizeof *nm->density);
     nm->density->slot = murk_counter_slot(s->nmedia);
-    nm->density->field = dn ? load_density(s, dn, err, errlen) : murk_field_constant(1.0f);
+    nm->density->field = dn ? murk_media_scalar_field(s, dn, "density", err, errlen) : murk_field_constant(1.0f);
     if (!nm->density->field)
         return -1;
     if (murk_bound_grid_build(nm->density->field, (int)core[K_MAJORANT_RESOLUTION].f[0], &nm->density->grid) != 0)
@@ -296,6 +381,8 @@ static int load_medium(murk_scene *s, const murk_host *host, const char *name, c
     nm->density->factor = (float)(repair && mf < 1.0 ? 1.0 : mf);
     md->density = nm->density;
     md->name = nm->name = murk_strdup(name);
+    if (load_extras(s, host, name, who, m, core, nm, err, errlen))
+        return -1;
     if (mf < 1.0) {
         const murk_bound_grid *g = &nm->density->grid;
         size_t n = (size_t)g->res[0] * (size_t)g->res[1] * (size_t)g->res[2], bad = 0;
@@ -321,13 +408,14 @@ static int load_medium(murk_scene *s, const murk_host *host, const char *name, c
     /* then the tracker, with the core's keys skipped */
     nskip = 0;
     skip[nskip++] = "type";
-    for (size_t i = 0; i < 2; i++)
+    for (size_t i = 0; i < MURK_MEDIUM_NSPECIAL; i++)
         skip[nskip++] = murk_medium_special_keys[i];
     for (size_t i = 0; i < MURK_MEDIUM_NCORE; i++)
         skip[nskip++] = murk_medium_core_params[i].name;
     const murk_plugin *p;
     if (murk_scene_instantiate(s, host, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self,
-                               err, errlen))
+                               err, errlen) ||
+        check_tracker_fields(p, md, m, who, err, errlen))
         return -1;
     nm->m.vt = p->desc->vtable;
     nm->m.name = nm->name;
@@ -344,6 +432,9 @@ static void medium_free(murk_named_medium *nm)
     if (nm->m.tr_vt && nm->m.tr_self)
         nm->m.tr_vt->destroy(nm->m.tr_self);
     if (nm->density) {
+        if (nm->density->phase.vt)
+            nm->density->phase.vt->destroy(nm->density->phase.self);
+        murk_fields_free(&nm->density->fields);
         murk_field_free(nm->density->field);
         murk_bound_grid_free(&nm->density->grid);
         free(nm->density);
@@ -365,6 +456,25 @@ int murk_media_load(murk_scene *s, const murk_host *host, const murk_ynode *n, c
         }
         murk_media_count_medium(&nm->m, nm->density->slot);
         s->nmedia++;
+    }
+    return 0;
+}
+
+int murk_media_bind_integrator(murk_scene *s, const murk_ynode *media_node, const char *integrator, uint32_t minor,
+                               char *err, size_t errlen)
+{
+    for (size_t i = 0; i < s->nmedia; i++) {
+        murk_medium_data *md = &s->media[i].data;
+        md->integrator_minor = minor;
+        if (!(md->fields & MURK_FIELD_EMISSION) || minor >= MURK_ABI_MINOR_FIELDS)
+            continue;
+        const murk_ynode *m = media_node ? murk_ymap_get(media_node, s->media[i].name) : NULL, *at = NULL;
+        if (m && !(at = murk_ymap_get(m, "emission")))
+            at = murk_ymap_get(m, "temperature");
+        murk_ynode here = {.file = s->doc.file, .line = 0, .col = 0};
+        return murk_yerr(err, errlen, at ? at : m ? m : &here, "medium '%s' emits, and integrator '%s' was built for "
+                         "plugin ABI 1.%u, before volume emission (1.%d): it would not collect it; rebuild it, or use "
+                         "volpath or volpath_nee", s->media[i].name, integrator, minor, MURK_ABI_MINOR_FIELDS);
     }
     return 0;
 }

@@ -17,11 +17,23 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
                            char *err, size_t errlen);
 
 /* The keys every medium has, read by the core whatever the tracker (sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution, majorant_repair, stratify_flights), as a parameter schema; and the two keys read apart from it
- * ("density", "transmittance"). `murk plugins TRACKER` lists them. */
-#define MURK_MEDIUM_NCORE 8
+ * majorant_factor, majorant_resolution, majorant_repair, stratify_flights, temperature_scale,
+ * temperature_offset), as a parameter schema; and the keys read apart from it ("density", "transmittance",
+ * "phase", "albedo", "emission", "temperature"). `murk plugins TRACKER` lists them. */
+#define MURK_MEDIUM_NCORE 10
+#define MURK_MEDIUM_NSPECIAL 6
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
-extern const char *const murk_medium_special_keys[2];
+extern const char *const murk_medium_special_keys[MURK_MEDIUM_NSPECIAL];
+struct murk_field;
+/* A scalar field from a scene node { constant: V } | { grid: F.vol|F.nvdb } | { cloud: {...} }; what names it
+ * in messages ("density", "temperature"). NULL with a located error. */
+struct murk_field *murk_media_scalar_field(const murk_scene *s, const murk_ynode *d, const char *what, char *err,
+                                           size_t errlen);
+/* Tells every medium the ABI minor of the scene's integrator (murk_medium_data.integrator_minor) and refuses
+ * an emitting medium with an integrator built before ABI 1.9 (a located error at its emission or
+ * temperature key of media_node). */
+int murk_media_bind_integrator(murk_scene *s, const murk_ynode *media_node, const char *integrator, uint32_t minor,
+                               char *err, size_t errlen);
 void murk_media_free(murk_scene *s);
 /* Wraps a scene's medium (its tracker and, if any, its transmittance estimator) so that every free
  * flight that scatters and every transmittance estimate is counted in the medium's slot (counted.c).
@@ -40,5 +52,13 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
 murk_counters *murk_media_counters(const murk_density *d);
 float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi);
 murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf);
+/* The host's medium services of ABI 1.9 (murk/plugin.h): a medium's phase function, albedo and emission. */
+float murk_media_phase_eval(const murk_medium *m, murk_vec3 wo, murk_vec3 wi);
+float murk_media_phase_sample(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf);
+murk_rgb murk_media_albedo(const murk_density *d, murk_vec3 p);
+/* The medium's phase-function plugin (vt NULL: the built-in Henyey-Greenstein of its g), for murk check. */
+struct murk_phase;
+const struct murk_phase *murk_media_phase(const murk_medium *m);
+murk_rgb murk_media_emission(const murk_density *d, murk_vec3 p);
 
 #endif

@@ -1,4 +1,5 @@
-/* vol.c — Mitsuba 3 .vol density grids: reading and writing (see density.h for what is accepted).
+/* vol.c — Mitsuba 3 .vol grids: density (1 channel) and RGB (1 or 3 channels: albedo, emission) reading,
+ * density writing (see density.h for what is accepted).
  *
  * Format (little-endian): 'V' 'O' 'L' 3 | int32 encoding (1 = float32) | int32 xres, yres, zres |
  * int32 channels | float32 xmin ymin zmin xmax ymax zmax | float32 data[((z*yres + y)*xres + x)*channels + c]. */
@@ -43,12 +44,15 @@ static int host_is_little_endian(void)
 
 #define VOL_HEADER 48
 
-murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
+/* Reads a .vol file of 1 to max_ch channels: *ch, the resolution, the box and the interleaved float32
+ * voxels (*data, the caller's to free). -1 with err on any fault. */
+static int vol_read(const char *path, int max_ch, int *ch_out, int res[3], murk_vec3 *lo_out, murk_vec3 *hi_out,
+                    float **data_out, char *err, size_t errlen)
 {
     uint64_t fsize;
     FILE *fp = murk_file_open_regular(path, &fsize, err, errlen);
     if (!fp)
-        return NULL;
+        return -1;
     unsigned char h[VOL_HEADER];
     size_t got = fread(h, 1, sizeof h, fp);
     if (got >= 3 && memcmp(h, "VOL", 3) != 0) {
@@ -78,8 +82,11 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
             murk_err_file(err, errlen, path, "resolution %d x %d x %d exceeds the limit of %llu voxels", (int)rx, (int)ry, (int)rz, (unsigned long long)MURK_FIELD_MAX_VOXELS);
         goto fail;
     }
-    if (ch != 1) {
-        murk_err_file(err, errlen, path, "%d channels; a density grid needs exactly 1 (extract one channel)", (int)ch);
+    if (ch != 1 && (max_ch == 1 || ch != max_ch)) {
+        if (max_ch == 1)
+            murk_err_file(err, errlen, path, "%d channels; a density grid needs exactly 1 (extract one channel)", (int)ch);
+        else
+            murk_err_file(err, errlen, path, "%d channels; an RGB grid has 1 (grey) or %d", (int)ch, max_ch);
         goto fail;
     }
     murk_vec3 lo = murk_v3(rd_f32(h + 24), rd_f32(h + 28), rd_f32(h + 32));
@@ -88,7 +95,7 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
         murk_err_file(err, errlen, path, "bad bounding box (%g %g %g)-(%g %g %g); need finite min < max, at least 1e-20 apart, on every axis", (double)lo.x, (double)lo.y, (double)lo.z, (double)hi.x, (double)hi.y, (double)hi.z);
         goto fail;
     }
-    uint64_t want = n * 4u, have = fsize - VOL_HEADER;
+    uint64_t want = n * 4u * (uint64_t)ch, have = fsize - VOL_HEADER;
     if (have < want) {
         murk_err_file(err, errlen, path, "truncated data: %d x %d x %d voxels need %llu bytes, the file holds %llu", (int)rx, (int)ry, (int)rz, (unsigned long long)want, (unsigned long long)have);
         goto fail;
@@ -97,25 +104,74 @@ murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
         murk_err_file(err, errlen, path, "%llu bytes after the data (does the header's resolution %d x %d x %d match?)", (unsigned long long)(have - want), (int)rx, (int)ry, (int)rz);
         goto fail;
     }
-    float *data = malloc((size_t)n * sizeof *data);
+    size_t nv = (size_t)n * (size_t)ch;
+    float *data = malloc(nv * sizeof *data);
     if (!data) {
         murk_err_file(err, errlen, path, "out of memory for %llu voxels", (unsigned long long)n);
         goto fail;
     }
-    if (fread(data, 4, (size_t)n, fp) != (size_t)n) {
+    if (fread(data, 4, nv, fp) != nv) {
         murk_err_file(err, errlen, path, "read error: %s", ferror(fp) ? strerror(errno) : "unexpected end of file");
         free(data);
         goto fail;
     }
     fclose(fp);
     if (!host_is_little_endian())
-        for (uint64_t i = 0; i < n; i++)
+        for (size_t i = 0; i < nv; i++)
             data[i] = rd_f32((const unsigned char *)&data[i]);
-    int res[3] = {rx, ry, rz}, org[3] = {0, 0, 0};
-    return murk_field_adopt(path, res, org, lo, hi, data, err, errlen);
+    *ch_out = ch;
+    res[0] = rx, res[1] = ry, res[2] = rz;
+    *lo_out = lo;
+    *hi_out = hi;
+    *data_out = data;
+    return 0;
 fail:
     fclose(fp);
-    return NULL;
+    return -1;
+}
+
+murk_field *murk_field_vol_load(const char *path, char *err, size_t errlen)
+{
+    int ch, res[3], org[3] = {0, 0, 0};
+    murk_vec3 lo, hi;
+    float *data;
+    if (vol_read(path, 1, &ch, res, &lo, &hi, &data, err, errlen))
+        return NULL;
+    return murk_field_adopt(path, res, org, lo, hi, data, err, errlen);
+}
+
+int murk_field_vol_load3(const char *path, murk_field *out[3], char *err, size_t errlen)
+{
+    int ch, res[3], org[3] = {0, 0, 0};
+    murk_vec3 lo, hi;
+    float *data;
+    out[0] = out[1] = out[2] = NULL;
+    if (vol_read(path, 3, &ch, res, &lo, &hi, &data, err, errlen))
+        return -1;
+    if (ch == 1) {
+        out[0] = out[1] = out[2] = murk_field_adopt(path, res, org, lo, hi, data, err, errlen);
+        return out[0] ? 1 : -1;
+    }
+    size_t n = (size_t)res[0] * (size_t)res[1] * (size_t)res[2];
+    for (int c = 0; c < 3; c++) { /* the channels apart: each a field of its own, checked and wrapped */
+        float *plane = malloc(n * sizeof *plane);
+        if (!plane) {
+            murk_err_file(err, errlen, path, "out of memory");
+        } else {
+            for (size_t i = 0; i < n; i++)
+                plane[i] = data[3 * i + (size_t)c];
+            out[c] = murk_field_adopt(path, res, org, lo, hi, plane, err, errlen);
+        }
+        if (!out[c]) {
+            for (int k = 0; k < c; k++)
+                murk_field_free(out[k]);
+            out[0] = out[1] = out[2] = NULL;
+            free(data);
+            return -1;
+        }
+    }
+    free(data);
+    return 3;
 }
 
 typedef struct vol_out {

@@ -10,6 +10,7 @@
 #include "murk/integrator.h"
 #include "murk/material.h"
 #include "murk/medium.h"
+#include "murk/phase.h"
 #include "murk/transmittance.h"
 
 #include <dirent.h>
@@ -33,6 +34,7 @@ const char *murk_kind_name(int kind)
     case MURK_KIND_MEDIUM: return "medium";
     case MURK_KIND_INTEGRATOR: return "integrator";
     case MURK_KIND_TRANSMITTANCE: return "transmittance";
+    case MURK_KIND_PHASE: return "phase";
     default: return "unknown-kind";
     }
 }
@@ -138,6 +140,7 @@ static size_t vtable_min_size(int kind)
     case MURK_KIND_MEDIUM: return MURK_MEDIUM_VT_SIZE_1_0;
     case MURK_KIND_INTEGRATOR: return MURK_INTEGRATOR_VT_SIZE_1_0;
     case MURK_KIND_TRANSMITTANCE: return MURK_TRANSMITTANCE_VT_SIZE_1_2; /* the kind's first ABI */
+    case MURK_KIND_PHASE: return MURK_PHASE_VT_SIZE_1_9;
     default: return 0;
     }
 }
@@ -348,7 +351,7 @@ int murk_plugin_open(const char *path, int kind, murk_plugin *out, char *err, si
     else if (d->struct_size < MURK_PLUGIN_DESC_SIZE_1_0)
         rc = fail(err, errlen, path, "descriptor struct_size is %u bytes, expected at least %zu for ABI %u.%u",
                   d->struct_size, (size_t)MURK_PLUGIN_DESC_SIZE_1_0, abicopy.major, abicopy.minor);
-    else if (d->kind < MURK_KIND_MATERIAL || d->kind > MURK_KIND_TRANSMITTANCE)
+    else if (d->kind < MURK_KIND_MATERIAL || d->kind > MURK_KIND_PHASE)
         rc = fail(err, errlen, path, "unknown plugin kind %u", d->kind);
     else if (!d->name || strlen(d->name) != blen || strncmp(d->name, base, blen) != 0)
         rc = fail(err, errlen, path, "declares the name '%s' but its file is named '%.*s.so' (names must match)",

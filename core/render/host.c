@@ -237,6 +237,11 @@ static const murk_host host_table = {
     .light_pdf_with = murk_lights_pdf,
     .boundaries = host_boundaries,
     .environment_pdf = murk_lights_environment_pdf,
+    .medium_phase_eval = murk_media_phase_eval,
+    .medium_phase_sample = murk_media_phase_sample,
+    .albedo = murk_media_albedo,
+    .emission = murk_media_emission,
 };
 
-const murk_host *murk_host_table(void) { return &host_table; }
+/* Exported for libmurklab: murk check calls the methods of the plugins it checks with the real table. */
+MURK_API const murk_host *murk_host_table(void) { return &host_table; }

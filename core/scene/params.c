@@ -10,6 +10,7 @@
 
 #include "murk/integrator.h"
 #include "murk/material.h"
+#include "murk/phase.h"
 #include "murk/transmittance.h"
 
 #include <stdio.h>
@@ -227,6 +228,7 @@ int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const
     case MURK_KIND_TRANSMITTANCE:
         rc = ((const murk_transmittance_vt *)p->desc->vtable)->create(host, data, vals, self, cerr, sizeof cerr);
         break;
+    case MURK_KIND_PHASE: rc = ((const murk_phase_vt *)p->desc->vtable)->create(host, vals, self, cerr, sizeof cerr); break;
     default: rc = -1; snprintf(cerr, sizeof cerr, "unknown plugin kind %d", kind);
     }
     if (rc != 0) { /* a refusal of values a --set gave is the --set's: quote the last one */

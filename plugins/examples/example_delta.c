@@ -12,6 +12,13 @@
  * reweighted by a_k / q (real) or (1 - a_k) / (1 - q) (null): unbiased, weights bounded. The same
  * reweighting keeps the estimate unbiased should a density exceed the majorant (said once).
  *
+ * Albedo and emission fields (murk/medium.h, ABI 1.9): with a field (tr->fields != 0) every tentative
+ * collision asks murk_local_sigma() for the local sigma_a and sigma_s (an albedo field changes the split of
+ * extinction, not extinction) and, if the medium emits, adds its emission score with murk_emit(): the
+ * collision estimator, sigma_a Le / mu times the running weight at every tentative collision, unbiased
+ * on coloured media too. murk's own trackers compile their loop twice so that media without fields pay
+ * nothing for this (murk/tracking.h); an example can afford the branch.
+ *
  * Transmittance (shadow rays): ratio tracking, murk_tracker_transmittance() from murk/tracking.h.
  *
  * Thread-safety: sample() and transmittance() run on every render thread at once; the instance is
@@ -45,17 +52,27 @@ static void ed_sample(const void *self, const murk_ray *ray, const murk_path_ctx
         return;
     murk_collisions c;
     murk_collisions_init(&c, tr, ray, tr->smax);
-    float t, dens;
+    float t, dens, sa[3], ss[3];
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a[3];
         for (int k = 0; k < 3; k++) /* real share of this tentative collision, per channel */
             a[k] = dens * tr->sigma_t.c[k] / c.mu;
+        murk_vec3 p = murk_madd(ray->o, ray->d, t);
+        if (tr->fields) /* an albedo field or emission: the local coefficients at p */
+            murk_local_sigma(tr, p, dens, sa, ss);
+        else
+            for (int k = 0; k < 3; k++) {
+                sa[k] = dens * tr->d->sigma_a.c[k];
+                ss[k] = dens * tr->d->sigma_s.c[k];
+            }
+        if (murk_emitting(tr)) /* before the collision's choice, with the weight so far */
+            murk_emit(tr, ctx, ev, p, sa, c.mu, ev->weight, murk_rgb1(1.0f));
         if (a[0] > 1.0f || a[1] > 1.0f || a[2] > 1.0f)
             murk_warn_majorant(tr, "example_delta weights its collisions");
         float q = murk_collision_prob(tr, a, ctx, ev->weight); /* = a for grey extinction */
         if (murk_rng_float(rng) < q) {
-            for (int k = 0; k < 3; k++) /* dens sigma_s,k / (mu q): the albedo when q = a */
-                ev->weight.c[k] *= dens * tr->d->sigma_s.c[k] / (c.mu * q);
+            for (int k = 0; k < 3; k++) /* sigma_s,k / (mu q): the albedo when q = a */
+                ev->weight.c[k] *= ss[k] / (c.mu * q);
             ev->scattered = 1;
             ev->t = t;
             return;

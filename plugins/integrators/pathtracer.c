@@ -19,6 +19,7 @@
 #include <stdio.h>
 
 #include "murk/material.h"
+#include "murk/tracking.h"
 
 /* Each parameter's only description (murk plugins NAME prints it; docs/plugins.md is generated from it). */
 #define PT_SHARED_PARAMS \
@@ -59,6 +60,16 @@ const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
                              "it (a lamp in or beside thin fog: scenes/fog_lamp.yaml); it costs more per sample, "
                              "is about even in an optically thin-to-moderate medium and loses in a dense cloud "
                              "(docs/results.md, \"Equiangular sampling\"), so it is off by default"},
+    [MURK_PT_NEE_MIS] = {"nee_mis", MURK_PARAM_ENUM, 0, {0, 0, 0}, "solid_angle", "solid_angle|null_scattering", 0, 0,
+                         "how a light sample and the emission that phase or BSDF sampling finds are weighted against "
+                         "each other: solid_angle, the power heuristic on the two directions' solid-angle pdfs "
+                         "(transmittance ignored); null_scattering, the path-level MIS of Miller, Georgiev and "
+                         "Jarosz 2019 (sec. 5): the balance heuristic over both strategies and the three channels' "
+                         "techniques, each pdf including the probability that free flights pass the null "
+                         "collisions between the vertex and the light (shadow rays ratio-track at the free flights' "
+                         "majorant to know it), so that light sampling takes over where a medium is dense and "
+                         "chromatic. null_scattering needs trackers that report null probabilities (spectral_mis; "
+                         "without closed_form) and excludes equiangular"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -96,6 +107,13 @@ int murk_pt_create(const murk_host *host, const murk_value *params, int nee, int
     pt->nee = nee;
     pt->media = media;
     pt->equiangular = nee && media && params[MURK_PT_EQUIANGULAR].f[0] != 0.0;
+    pt->nee_mis = nee && media && params[MURK_PT_NEE_MIS].choice == 1;
+    if (pt->nee_mis && pt->equiangular) {
+        snprintf(err, errlen, "nee_mis: null_scattering and equiangular cannot be combined (equiangular's "
+                 "vertices have no null-collision pdf)");
+        host->free(pt);
+        return -1;
+    }
     *self = pt;
     return 0;
 }
@@ -171,16 +189,21 @@ static murk_ray ray_from(murk_vec3 o, murk_vec3 d)
 
 /* An origin offset along a boundary's normal is off the original line from p to q: a leg that kept
  * the first direction, with a length measured along it, reaches a light parallel to the boundary
- * early and counts the light itself as an occluder. So every leg is re-aimed at q. */
+ * early and counts the light itself as an occluder. So every leg is re-aimed at q. With pnull (nee_mis:
+ * null_scattering) every medium leg is ratio-tracked at the free flights' majorant and *pnull (1 on entry)
+ * gathers the null-collision probabilities of its tentative collisions (murk_ratio_tracking_null). */
 /* A light at infinity (inf = 1) is reached along wi itself: every leg keeps that direction and runs to
  * infinity (a medium's majorant walk ends at its density's box; a constant medium is bounded by its
  * boundary shapes). */
 static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
-                       murk_vec3 wi, int inf, const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+                       murk_vec3 wi, int inf, const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng,
+                       murk_rgb *pnull)
 {
     const murk_host *h = pt->host;
     const float end_eps = inf ? 0.0f : 1e-4f * murk_maxf(1.0f, maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
+    if (pnull)
+        *pnull = T;
     if (!pt->media)
         m = NULL;
     murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, inf ? wi : murk_sub(q, p)) : p;
@@ -205,7 +228,13 @@ static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, 
         if (m) {
             murk_ray seg = r;
             seg.tmax = found ? hit.t : r.tmax;
-            murk_rgb Tm = murk_medium_transmittance(m, &seg, ctx, rng);
+            murk_rgb Tm, Pm;
+            if (pnull) {
+                Tm = murk_ratio_tracking_null(h, m->data, &seg, rng, &Pm);
+                *pnull = murk_rgb_mul(*pnull, Pm);
+            } else {
+                Tm = murk_medium_transmittance(m, &seg, ctx, rng);
+            }
             if (!finite3(Tm))
                 return murk_rgb1((float)broken(h, "medium", m->name, "transmittance"));
             T = murk_rgb_mul(T, Tm);
@@ -227,13 +256,13 @@ static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, 
 murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
                         const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
 {
-    return shadow(pt, scene, p, offset_n, q, murk_v3(0, 0, 0), 0, m, ctx, rng);
+    return shadow(pt, scene, p, offset_n, q, murk_v3(0, 0, 0), 0, m, ctx, rng, NULL);
 }
 
 murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 wi,
                             const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
 {
-    return shadow(pt, scene, p, offset_n, p, wi, 1, m, ctx, rng);
+    return shadow(pt, scene, p, offset_n, p, wi, 1, m, ctx, rng, NULL);
 }
 
 /* ---- path state ---------------------------------------------------------------------------- */
@@ -248,6 +277,10 @@ typedef struct path {
     float prev_pdf;
     int prev_delta; /* 1 at the camera and after a delta lobe: no light sample competed */
     int prev_phase; /* the last scattering vertex was in a medium (for the tap: phase-found emission) */
+    /* nee_mis null_scattering: R at the last scattering vertex, and the product of the hero's null-collision
+     * probabilities over the free flights since it */
+    murk_rgb R_vertex;
+    float null_hero;
     int depth, crossings;
     float eta_scale; /* product of eta^2 over transmissions: beta * eta_scale is free of the 1 / eta^2 that
                       * radiance picks up entering a denser medium (for Russian roulette only) */
@@ -282,7 +315,7 @@ typedef struct vertex {
     const murk_material *mat;
     const murk_shading *sp; /* the material's shading point at the vertex */
     murk_vec3 t, b, n, wo_local;
-    float g;
+    const murk_medium *medium; /* the medium whose phase function scatters (mat == NULL) */
     const murk_medium *behind; /* the medium on the far side of the surface from wo */
 } vertex;
 
@@ -299,7 +332,7 @@ static int vertex_side_ok(const vertex *v, murk_vec3 wi, murk_vec3 wl)
 static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
-        return murk_rgb1(h->phase_eval(v->g, v->wo, wi));
+        return murk_rgb1(h->medium_phase_eval(v->medium, v->wo, wi));
     murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
     if (!vertex_side_ok(v, wi, wl))
         return murk_rgb1(0.0f);
@@ -310,7 +343,7 @@ static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
 static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
-        return h->phase_eval(v->g, v->wo, wi);
+        return h->medium_phase_eval(v->medium, v->wo, wi);
     return murk_material_pdf(v->mat, v->sp, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
 }
 
@@ -348,9 +381,10 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
         return f;
     /* a light behind a transmitting surface is reached through the medium on that side */
     const murk_medium *m = v->mat && murk_dot(ls->wi, v->offset_n) < 0.0f ? v->behind : st->medium;
-    murk_rgb T = isinf(ls->dist) ? murk_pt_shadow_inf(pt, scene, v->p, v->offset_n, ls->wi, m, &st->ctx, rng)
-                                 : murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m,
-                                                  &st->ctx, rng);
+    murk_rgb P; /* nee_mis: the shadow ray's null-collision probabilities (shadow() sets them) */
+    int inf = isinf(ls->dist);
+    murk_rgb T = shadow(pt, scene, v->p, v->offset_n, inf ? v->p : murk_madd(v->p, ls->wi, ls->dist),
+                        inf ? ls->wi : murk_v3(0, 0, 0), inf, m, &st->ctx, rng, pt->nee_mis ? &P : NULL);
     if (murk_rgb_is_black(T))
         return T;
     if (ls->flags & MURK_LIGHT_SAMPLE_DELTA) /* no BSDF or phase sample can hit a delta light: weight 1 */
@@ -360,7 +394,15 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
         return murk_rgb1(0.0f);
     }
-    return murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(f, T), ls->le), power_heuristic(ls->pdf, pdf) / ls->pdf);
+    murk_rgb c = murk_rgb_mul(murk_rgb_mul(f, T), ls->le);
+    if (pt->nee_mis) { /* the balance heuristic over {light, free flight} x channels, R and P per channel */
+        murk_rgb R = st->R;
+        float d = 0.0f;
+        for (int k = 0; k < 3; k++)
+            d += R.c[k] * (ls->pdf + pdf * P.c[k]);
+        return murk_rgb_scale(c, d > 0.0f ? (R.c[0] + R.c[1] + R.c[2]) / d : 0.0f);
+    }
+    return murk_rgb_scale(c, power_heuristic(ls->pdf, pdf) / ls->pdf);
 }
 
 /* ---- equiangular sampling along a medium segment (Kulla and Fajardo 2012) ----------------------
@@ -474,7 +516,7 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     vertex v = {0};
     v.p = x;
     v.wo = murk_neg(st->ray.d);
-    v.g = m->data->g;
+    v.medium = m;
     path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
     at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
     at.L = murk_rgb1(0.0f);
@@ -496,42 +538,90 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     murk_ray seg = st->ray;
     seg.tmax = tmax;
     murk_medium_event ev;
+    ev.emitted = murk_rgb1(0.0f); /* a tracker adds an emitting medium's radiance (murk/medium.h) */
+    ev.null_prob = -1.0f;
     st->ctx.beta = st->beta;
+    st->ctx.pdf_ratio = st->R;
     murk_sample_seek(rng, PT_SLOT_FLIGHT(st->depth, st->crossings));
     m->vt->sample(m->self, &seg, &st->ctx, rng, &ev);
     if (!finite3(ev.weight) || !finite3(ev.pdf_ratio) || (ev.scattered && !isfinite(ev.t))) {
         broken(h, "medium", m->name, "free-flight weight");
         return PT_END;
     }
+    if (!murk_rgb_is_black(ev.emitted)) { /* credited with beta and R before the flight */
+        if (!finite3(ev.emitted))
+            return broken(h, "medium", m->name, "emitted radiance"), PT_END;
+        add_light(st, ev.emitted, 1.0f, MURK_PT_TERM_MEDIUM_EMISSION);
+    }
     st->beta = murk_rgb_mul(st->beta, ev.weight);
     st->R = murk_rgb_mul(st->R, ev.pdf_ratio);
     if (murk_rgb_is_black(st->beta) || !(mean3(st->R) > 0.0f))
         return PT_TAP_END(st, MURK_PT_END_ABSORBED), PT_END;
-    if (!ev.scattered)
+    if (!ev.scattered) {
+        if (pt->nee_mis && !(ev.null_prob >= 0.0f)) {
+            h->warn_once("integrator 'volpath_nee' with nee_mis: null_scattering: the tracker of medium '%s' does not "
+                         "report null-collision probabilities (use spectral_mis without closed_form); its paths were "
+                         "ended (biased)", m->name);
+            return PT_END;
+        }
+        if (pt->nee_mis)
+            st->null_hero *= ev.null_prob;
         return PT_PASSED;
+    }
     if (st->depth >= pt->max_depth)
         return PT_TAP_END(st, MURK_PT_END_MAX_DEPTH), PT_END;
     vertex v = {0};
     v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
     v.wo = murk_neg(st->ray.d);
-    v.g = m->data->g;
+    v.medium = m;
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
         sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t),
                      MURK_PT_TERM_MEDIUM_NEE, rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
-    murk_vec3 wi = h->phase_sample(v.g, v.wo, u, &pdf);
+    murk_vec3 wi;
+    float p = h->medium_phase_sample(m, v.wo, u, &wi, &pdf);
     if (!(pdf > 0.0f))
         return PT_END;
-    /* HG is sampled exactly: phase / pdf = 1, beta stays */
+    if (p != pdf) { /* murk's phase functions sample exactly (p / pdf = 1): beta stays */
+        if (!isfinite(p) || !isfinite(pdf))
+            return broken(h, "phase function of medium", m->name, "sample"), PT_END;
+        st->beta = murk_rgb_scale(st->beta, p / pdf);
+    }
     st->prev_p = v.p;
     st->prev_pdf = pdf;
     st->prev_delta = 0;
     st->prev_phase = 1;
+    if (pt->nee_mis) {
+        st->R_vertex = st->R;
+        st->null_hero = 1.0f;
+    }
     st->ray = ray_from(v.p, wi);
     st->depth++;
     return PT_SCATTERED;
+}
+
+/* The MIS weight of emission that phase or BSDF sampling found — an emitter's hit, or the environment
+ * (light sampling's pdf of it: pl) — against light sampling from the last vertex: the power heuristic
+ * on solid-angle pdfs, or (nee_mis: null_scattering) the balance
+ * heuristic over both strategies and the channels' techniques, relative to the path's own: the found path's
+ * pdf for channel k is R_k p_dir P_k and light sampling's R_vertex,k p_light (its null collisions ratio-
+ * tracked, at probability 1), with R_k / R_vertex,k = P_k / P_hero, so the weight times 1 / mean(R) that
+ * add_light applies is 1 / (mean(R) + mean(R_vertex) p_light / (p_dir P_hero)). */
+static float found_weight(const murk_pt *pt, const path *st, float pl)
+{
+    if (!pt->nee_mis)
+        return power_heuristic(st->prev_pdf, pl);
+    if (!(st->null_hero > 0.0f) || !(st->prev_pdf > 0.0f))
+        return 0.0f;
+    float m = mean3(st->R), d = m + mean3(st->R_vertex) * pl / (st->prev_pdf * st->null_hero);
+    return d > 0.0f ? m / d : 0.0f;
+}
+
+static float found_light_weight(const murk_pt *pt, const murk_scene *scene, const path *st, const murk_hit *hit)
+{
+    return found_weight(pt, st, pt->host->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy));
 }
 
 /* Emission at a surface hit, then (below max_depth) light sampling and BSDF sampling. Returns 0 when
@@ -542,8 +632,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     murk_vec3 wo = murk_neg(st->ray.d);
     murk_rgb le = murk_hit_le(hit, wo);
     if (!murk_rgb_is_black(le))
-        add_light(st, le, pt->nee && !st->prev_delta ? power_heuristic(st->prev_pdf, h->light_pdf_with(scene, st->prev_p, hit, pt->light_strategy))
-                                                     : 1.0f,
+        add_light(st, le, pt->nee && !st->prev_delta ? found_light_weight(pt, scene, st, hit) : 1.0f,
                   st->depth == 0 ? MURK_PT_TERM_CAMERA_EMISSION : st->prev_phase ? MURK_PT_TERM_PHASE_EMISSION
                                                                                  : MURK_PT_TERM_BSDF_EMISSION);
     if (st->depth >= pt->max_depth)
@@ -596,6 +685,10 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     st->prev_pdf = bs.pdf;
     st->prev_delta = bs.delta;
     st->prev_phase = 0;
+    if (pt->nee_mis) {
+        st->R_vertex = st->R;
+        st->null_hero = 1.0f;
+    }
     st->ray = ray_from(offset(hit->p, v.offset_n, wi), wi);
     st->depth++;
     return 1;
@@ -608,7 +701,7 @@ static float escaped_weight(const murk_pt *pt, const murk_scene *scene, const pa
     if (!pt->nee || st->prev_delta)
         return 1.0f;
     float pe = pt->host->environment_pdf(scene, st->ray.d);
-    return pe > 0.0f ? power_heuristic(st->prev_pdf, pe) : 1.0f;
+    return pe > 0.0f ? found_weight(pt, st, pe) : 1.0f;
 }
 
 /* An index-matched boundary: the medium on the far side, the same direction. */
@@ -658,6 +751,9 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
     st.ray = *ray;
     st.prev_p = ray->o;
     st.prev_delta = 1;
+    st.R_vertex = st.R;
+    st.null_hero = 1.0f;
+    st.ctx.flags = pt->nee_mis ? MURK_CTX_NULL_PROB : 0u;
     for (;;) {
         murk_hit hit;
         int found = h->intersect(scene, &st.ray, &hit);

@@ -43,7 +43,7 @@
 enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 /* volpath_nee's: the shared ones, then its own. */
-enum { MURK_PT_EQUIANGULAR = MURK_PT_NPARAMS, MURK_PT_NEE_NPARAMS };
+enum { MURK_PT_EQUIANGULAR = MURK_PT_NPARAMS, MURK_PT_NEE_MIS, MURK_PT_NEE_NPARAMS };
 extern const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS];
 
 typedef struct murk_pt {
@@ -55,6 +55,7 @@ typedef struct murk_pt {
     float rr_threshold; /* Russian roulette's survival probability is min(1, weight / rr_threshold) (0: 1) */
     int equiangular;    /* volpath_nee: equiangular distance sampling towards a light point per medium
                          * segment, MIS-combined with the tracker's free flights (pathtracer.c) */
+    int nee_mis;        /* volpath_nee: nee_mis null_scattering, path-level MIS (pathtracer.c) */
 } murk_pt;
 
 /* create() for an integrator with the given strategy (params: murk_pt_nee_params when nee, else
@@ -80,11 +81,13 @@ murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec
 
 /* The techniques the path tracer tells apart, one for each contribution it makes to a sample (its
  * `term`): light sampling at a surface vertex, at a free-flight medium vertex and at the equiangular
- * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background.
+ * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background;
+ * emission of a medium, collected along free flights.
  * And how a path ended. Only a build with the tap (-DMURK_PT_TAP, pathtracer_tap.h: bench/variance_profile,
  * never the plugins) reports them. */
 enum { MURK_PT_TERM_SURFACE_NEE, MURK_PT_TERM_MEDIUM_NEE, MURK_PT_TERM_EQUIANGULAR_NEE, MURK_PT_TERM_BSDF_EMISSION,
-       MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_NTERMS };
+       MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_TERM_MEDIUM_EMISSION,
+       MURK_PT_NTERMS };
 enum { MURK_PT_END_ROULETTE, MURK_PT_END_MAX_DEPTH, MURK_PT_END_ABSORBED, MURK_PT_END_ESCAPED, MURK_PT_NENDS };
 
 #endif

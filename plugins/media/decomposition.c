@@ -83,10 +83,43 @@ static float decomposition_depth(murk_rng *rng, int *first, float *uc, float *ca
     return tau;
 }
 
-static void decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                                 murk_medium_event *ev)
+/* Says once that a residual collision met a bound that failed: the control above the density (amin < 0)
+ * or the density above the majorant (amax > 1). */
+static void decomposition_warn(const decomposition *m, float amin, float amax)
 {
-    const decomposition *m = self;
+    if (amin < 0.0f)
+        m->base.host->warn_once("medium '%s': decomposition control exceeds the local density (repair: false): "
+                                "decomposition tracking weights the violating residual collision and lowers the "
+                                "rest of the flight's control below the density seen (unbiased; noisier than "
+                                "repair: true)", m->base.d->name);
+    if (amax > 1.0f)
+        murk_warn_majorant(&m->base, "decomposition tracking weights");
+}
+
+/* The watchdog (murk/plugin.h) stopped the flight at t: said once, the path ends. */
+static void decomposition_stop(const decomposition *m, murk_medium_event *ev, float t)
+{
+    murk_tracker_watchdog(&m->base, "a free flight");
+    murk_event_kill(ev, t);
+}
+
+/* The medium's fields at a tentative collision at t (rate mu: control + residual): the local sigma_a and
+ * sigma_s into sa, ss, and the emission score (murk/tracking.h). */
+static void decomposition_fields(const decomposition *m, const murk_ray *ray, const murk_path_ctx *ctx,
+                                 murk_medium_event *ev, float t, float dens, float mu, float sa[3], float ss[3])
+{
+    murk_vec3 p = murk_madd(ray->o, ray->d, t);
+    murk_local_sigma(&m->base, p, dens, sa, ss);
+    if (murk_emitting(&m->base))
+        murk_emit(&m->base, ctx, ev, p, sa, mu, ev->weight, murk_rgb1(1.0f));
+}
+
+/* One free flight; `fields` (a constant at each call) adds the medium's albedo field and emission: the
+ * instance without them is decomposition tracking as it always was. */
+static MURK_ALWAYS_INLINE void decomposition_flight(const decomposition *m, const murk_ray *ray,
+                                                    const murk_path_ctx *ctx, murk_rng *rng, murk_medium_event *ev,
+                                                    int fields)
+{
     const murk_host *h = m->base.host;
     const murk_medium_data *d = m->base.d;
     const murk_rgb st = m->base.sigma_t;
@@ -105,8 +138,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
     long steps = 0; /* the watchdog (murk/plugin.h): cells and collisions of this flight */
     while (h->walk_next(&w, &ta, &tb, &dmax, &dmin)) {
         if (++steps > MURK_WATCHDOG_ITERATIONS) {
-            murk_tracker_watchdog(&m->base, "a free flight");
-            murk_event_kill(ev, ta);
+            decomposition_stop(m, ev, ta);
             return;
         }
         float rate_c, mu_r;
@@ -118,8 +150,7 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             tc = murk_advance(ta, decomposition_depth(rng, &first, &uc, &tau_c, &dc) / rate_c);
         for (float t = ta;;) {
             if (++steps > MURK_WATCHDOG_ITERATIONS) {
-                murk_tracker_watchdog(&m->base, "a free flight");
-                murk_event_kill(ev, t);
+                decomposition_stop(m, ev, t);
                 return;
             }
             float tr = INFINITY, dr = 0.0f;
@@ -133,32 +164,35 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
                 break;
             }
             count->collisions++; /* a control or a residual collision */
+            float sa[3] = {0}, ss[3] = {0}; /* with fields: the local coefficients (albedo field, emission) */
+            if (fields && tc <= tr)
+                decomposition_fields(m, ray, ctx, ev, tc, h->density(d->density, murk_madd(ray->o, ray->d, tc)),
+                                     rate_c + mu_r, sa, ss);
             if (tc <= tr) { /* control collision */
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= st.c[k] > 0.0f ? d->sigma_s.c[k] / st.c[k] : 0.0f;
+                    ev->weight.c[k] *= st.c[k] > 0.0f ? (fields ? murk_ratio0(ss[k], sa[k] + ss[k])
+                                                               : d->sigma_s.c[k] / st.c[k]) : 0.0f;
                 ev->scattered = 1;
                 ev->t = tc;
                 return;
             }
             t = tr;
             float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
+            if (fields)
+                decomposition_fields(m, ray, ctx, ev, t, dens, rate_c + mu_r, sa, ss);
             float a[3], amin = INFINITY, amax = -INFINITY;
             for (int k = 0; k < 3; k++) { /* residual share of channel k */
                 a[k] = (dens * st.c[k] - rate_c) / mu_r;
                 amin = murk_minf(amin, a[k]);
                 amax = murk_maxf(amax, a[k]);
             }
-            if (amin < 0.0f)
-                h->warn_once("medium '%s': decomposition control exceeds the local density (repair: false): "
-                             "decomposition tracking weights the violating residual collision and lowers the "
-                             "rest of the flight's control below the density seen (unbiased; noisier than "
-                             "repair: true)", d->name);
-            if (amax > 1.0f)
-                murk_warn_majorant(&m->base, "decomposition tracking weights");
+            if (amin < 0.0f || amax > 1.0f) /* a bound failed: said once */
+                decomposition_warn(m, amin, amax);
             float q = murk_collision_prob(&m->base, a, ctx, ev->weight);
             if (murk_flight_choice(rng, &uc) < q) {
                 for (int k = 0; k < 3; k++)
-                    ev->weight.c[k] *= st.c[k] > 0.0f ? a[k] / q * (d->sigma_s.c[k] / st.c[k]) : 0.0f;
+                    ev->weight.c[k] *= st.c[k] > 0.0f ? a[k] / q * (fields ? murk_ratio0(ss[k], dens * st.c[k])
+                                                                          : d->sigma_s.c[k] / st.c[k]) : 0.0f;
                 ev->scattered = 1;
                 ev->t = t;
                 return;
@@ -180,6 +214,16 @@ static void decomposition_sample(const void *self, const murk_ray *ray, const mu
             }
         }
     }
+}
+
+static void decomposition_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                                 murk_medium_event *ev)
+{
+    const decomposition *m = self;
+    if (m->base.fields)
+        decomposition_flight(m, ray, ctx, rng, ev, 1);
+    else
+        decomposition_flight(m, ray, ctx, rng, ev, 0);
 }
 
 static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx,

@@ -22,28 +22,36 @@ static int delta_create(const murk_host *host, const murk_medium_data *data, con
     return 0;
 }
 
-static void delta_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                         murk_medium_event *ev)
+/* One free flight; `fields` (a constant at each call) adds the medium's albedo field and emission
+ * (murk/tracking.h): the instance without them is delta tracking as it always was. */
+static MURK_ALWAYS_INLINE void delta_flight(const murk_tracker *m, const murk_ray *ray, const murk_path_ctx *ctx,
+                                            murk_rng *rng, murk_medium_event *ev, int fields)
 {
-    const murk_tracker *m = self;
     murk_event_init(ev, ray);
     if (!(m->smax > 0.0f))
         return;
+    int emit = fields && murk_emitting(m);
     murk_collisions c;
     murk_collisions_init(&c, m, ray, m->smax);
-    float t, dens;
+    float t, dens, sa[3], ss[3];
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a[3], amax = 0.0f; /* real share of the collision per channel */
         for (int k = 0; k < 3; k++) {
             a[k] = dens * m->sigma_t.c[k] / c.mu;
             amax = murk_maxf(amax, a[k]);
         }
+        if (fields) {
+            murk_vec3 p = murk_madd(ray->o, ray->d, t);
+            murk_local_sigma(m, p, dens, sa, ss);
+            if (emit)
+                murk_emit(m, ctx, ev, p, sa, c.mu, ev->weight, murk_rgb1(1.0f));
+        }
         if (amax > 1.0f)
             murk_warn_majorant(m, "delta tracking weights");
         float q = murk_collision_prob(m, a, ctx, ev->weight);
         if (murk_collisions_choice(&c, rng) < q) {
             for (int k = 0; k < 3; k++) /* sigma_s,k(x) / (mu q): the albedo for grey extinction */
-                ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q);
+                ev->weight.c[k] *= (fields ? ss[k] : dens * m->d->sigma_s.c[k]) / (c.mu * q);
             ev->scattered = 1;
             ev->t = t;
             return;
@@ -55,6 +63,16 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);
+}
+
+static void delta_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                         murk_medium_event *ev)
+{
+    const murk_tracker *m = self;
+    if (m->fields)
+        delta_flight(m, ray, ctx, rng, ev, 1);
+    else
+        delta_flight(m, ray, ctx, rng, ev, 0);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, delta_create, murk_tracker_free,

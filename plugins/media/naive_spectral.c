@@ -17,10 +17,11 @@ static int naive_create(const murk_host *host, const murk_medium_data *data, con
     return (*self = m) ? 0 : -1;
 }
 
-static void naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                         murk_medium_event *ev)
+/* One free flight; `fields` (a constant at each call) adds the medium's albedo field and emission
+ * (murk/tracking.h): the instance without them is per-channel delta tracking as it always was. */
+static MURK_ALWAYS_INLINE void naive_flight(const murk_tracker *m, const murk_ray *ray, const murk_path_ctx *ctx,
+                                            murk_rng *rng, murk_medium_event *ev, int fields)
 {
-    const murk_tracker *m = self;
     int hero = ctx->hero;
     float st = m->sigma_t.c[hero];
     murk_event_init(ev, ray);
@@ -29,16 +30,23 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
     ev->pdf_ratio = ev->weight;
     if (!(st > 0.0f))
         return;
+    int emit = fields && murk_emitting(m);
     murk_collisions c;
     murk_collisions_init(&c, m, ray, st); /* the hero channel's own majorant */
-    float t, dens;
+    float t, dens, sa[3], ss[3];
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a = dens * st / c.mu;
+        if (fields) {
+            murk_vec3 p = murk_madd(ray->o, ray->d, t);
+            murk_local_sigma(m, p, dens, sa, ss);
+            if (emit) /* the hero's score, x3 through the pdf ratios (murk_emit) */
+                murk_emit(m, ctx, ev, p, sa, c.mu, ev->weight, ev->pdf_ratio);
+        }
         if (a > 1.0f)
             murk_warn_majorant(m, "per-channel delta tracking weights");
         float q = murk_real_prob(a, 1.0f - a);
         if (murk_collisions_choice(&c, rng) < q) {
-            ev->weight.c[hero] *= dens * m->d->sigma_s.c[hero] / (c.mu * q);
+            ev->weight.c[hero] *= (fields ? ss[hero] : dens * m->d->sigma_s.c[hero]) / (c.mu * q);
             ev->scattered = 1;
             ev->t = t;
             return;
@@ -49,6 +57,16 @@ static void naive_sample(const void *self, const murk_ray *ray, const murk_path_
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);
+}
+
+static void naive_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                         murk_medium_event *ev)
+{
+    const murk_tracker *m = self;
+    if (m->fields)
+        naive_flight(m, ray, ctx, rng, ev, 1);
+    else
+        naive_flight(m, ray, ctx, rng, ev, 0);
 }
 
 /* every channel's transmittance is estimated; only the hero's carries weight in the path */

@@ -44,23 +44,33 @@ static float pick(int scheme, const float x[3], const float w[3])
     return (fabsf(w[0] * x[0]) + fabsf(w[1] * x[1]) + fabsf(w[2] * x[2])) / 3.0f;
 }
 
-static void spectral_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                            murk_medium_event *ev)
+/* One free flight; `fields` (a constant at each call) adds the medium's albedo field and emission
+ * (murk/tracking.h): the instance without them is spectral tracking as it always was. */
+static MURK_ALWAYS_INLINE void spectral_flight(const spectral *m, const murk_ray *ray, const murk_path_ctx *ctx,
+                                               murk_rng *rng, murk_medium_event *ev, int fields)
 {
-    const spectral *m = self;
     const murk_medium_data *d = m->base.d;
     murk_event_init(ev, ray);
     if (!(m->base.smax > 0.0f))
         return;
+    int emit = fields && murk_emitting(&m->base);
     murk_collisions c;
     murk_collisions_init(&c, &m->base, ray, m->base.smax);
     float t, dens;
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float sa[3], ss[3], sn[3], hist[3];
         int neg = 0;
+        if (fields) {
+            murk_vec3 p = murk_madd(ray->o, ray->d, t);
+            murk_local_sigma(&m->base, p, dens, sa, ss);
+            if (emit)
+                murk_emit(&m->base, ctx, ev, p, sa, c.mu, ev->weight, murk_rgb1(1.0f));
+        }
         for (int k = 0; k < 3; k++) {
-            sa[k] = dens * d->sigma_a.c[k];
-            ss[k] = dens * d->sigma_s.c[k];
+            if (!fields) {
+                sa[k] = dens * d->sigma_a.c[k];
+                ss[k] = dens * d->sigma_s.c[k];
+            }
             sn[k] = c.mu - dens * m->base.sigma_t.c[k];
             neg |= sn[k] < 0.0f;
             hist[k] = ctx->beta.c[k] * ev->weight.c[k];
@@ -91,6 +101,16 @@ static void spectral_sample(const void *self, const murk_ray *ray, const murk_pa
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);
+}
+
+static void spectral_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                            murk_medium_event *ev)
+{
+    const spectral *m = self;
+    if (m->base.fields)
+        spectral_flight(m, ray, ctx, rng, ev, 1);
+    else
+        spectral_flight(m, ray, ctx, rng, ev, 0);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, spectral_create, murk_tracker_free,

@@ -46,10 +46,15 @@ static int smis_create(const murk_host *host, const murk_medium_data *data, cons
  * channel, so the ratios of the whole flight stay those of one technique per channel. One optical depth
  * tau for the hero, drawn once (a stratified flight's first number: murk_flight_float) and used up cell
  * by cell (memoryless: the same as a fresh draw per cell), so the stratification reaches the scattering
- * distance wherever it lies. *first says whether the flight's slot is still unused. */
-static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, int hero, murk_rng *rng, murk_medium_event *ev,
-                            float *from, int *first)
+ * distance wherever it lies. *first says whether the flight's slot is still unused. With an albedo field
+ * sigma_s,k is the local one at the collision; with emission the collision scores, as every collision of
+ * a tracked flight does (murk/tracking.h), e^(-s_k x) sigma_a,k Le_k / (s_h e^(-s_h x)) with the pdf ratios
+ * up to and including the collision: the collision estimator with the hero's exponential as its
+ * distance density. */
+static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                            murk_medium_event *ev, float *from, int *first)
 {
+    int hero = ctx->hero;
     const murk_host *h = m->host;
     murk_majorant_walk w;
     h->walk_init(m->d->density, ray, ray->tmin, ray->tmax, &w);
@@ -67,12 +72,21 @@ static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, int hero
         float x = sh > 0.0f ? tau / sh : INFINITY;
         tau -= sh * len;
         if (x < len) {
-            float ph = sh * expf(-sh * x);
+            float ph = sh * expf(-sh * x), sa[3], ss[3];
+            murk_vec3 p = murk_madd(ray->o, ray->d, a + x);
+            if (m->fields)
+                murk_local_sigma(m, p, dmax, sa, ss);
+            murk_rgb we; /* the flight's weight up to the collision, for its emission score */
             for (int k = 0; k < 3; k++) {
                 float sk = dmax * m->sigma_t.c[k], pk = sk * expf(-sk * x);
-                ev->weight.c[k] *= dmax * m->d->sigma_s.c[k] * expf(-sk * x) / ph;
+                if (!m->fields)
+                    ss[k] = dmax * m->d->sigma_s.c[k];
+                we.c[k] = ev->weight.c[k] * (expf(-sk * x) / ph);
+                ev->weight.c[k] *= ss[k] * expf(-sk * x) / ph;
                 ev->pdf_ratio.c[k] *= pk / ph;
             }
+            if (murk_emitting(m))
+                murk_emit(m, ctx, ev, p, sa, 1.0f, we, ev->pdf_ratio);
             ev->scattered = 1;
             ev->t = a + x;
             return 1;
@@ -86,22 +100,29 @@ static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, int hero
     return 1;
 }
 
-static void smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                        murk_medium_event *ev)
+/* One free flight; `fields` (a constant at each call) adds the medium's albedo field, its emission and the
+ * null probabilities an integrator may ask for (murk/medium.h, MURK_CTX_NULL_PROB): the instance without
+ * them is spectral MIS as it always was. */
+static MURK_ALWAYS_INLINE void smis_flight(const smis *sm, const murk_ray *ray, const murk_path_ctx *ctx,
+                                           murk_rng *rng, murk_medium_event *ev, int fields)
 {
-    const murk_tracker *m = self;
+    const murk_tracker *m = &sm->base;
     int hero = ctx->hero;
     murk_event_init(ev, ray);
     if (!(m->smax > 0.0f))
         return;
+    int emit = fields && murk_emitting(m);
+    int np = fields && m->d->integrator_minor >= MURK_ABI_MINOR_FIELDS && (ctx->flags & MURK_CTX_NULL_PROB) && !sm->closed_form;
+    if (np)
+        ev->null_prob = 1.0f; /* the product of the hero's null probabilities, for volpath_nee's nee_mis */
     murk_ray rest = *ray;
     int first = murk_flight_stratified(m->d);
-    if (((const smis *)self)->closed_form && smis_closed_form(m, ray, hero, rng, ev, &rest.tmin, &first))
+    if (sm->closed_form && smis_closed_form(m, ray, ctx, rng, ev, &rest.tmin, &first))
         return;
     murk_collisions c;
     murk_collisions_init(&c, m, &rest, m->smax); /* one majorant for every channel */
     c.first = first; /* 0 if the closed-form part took the flight's slot */
-    float t, dens;
+    float t, dens, sa[3], ss[3];
     while (murk_collisions_next(&c, rng, &t, &dens)) {
         float a[3], q[3], amax = 0.0f;
         for (int k = 0; k < 3; k++) {
@@ -109,11 +130,18 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
             q[k] = murk_real_prob(a[k], 1.0f - a[k]);
             amax = murk_maxf(amax, a[k]);
         }
+        if (fields && (emit || (m->fields & MURK_FIELD_ALBEDO))) {
+            murk_vec3 p = murk_madd(rest.o, rest.d, t);
+            murk_local_sigma(m, p, dens, sa, ss);
+            if (emit)
+                murk_emit(m, ctx, ev, p, sa, c.mu, ev->weight, ev->pdf_ratio);
+        }
         if (amax > 1.0f)
             murk_warn_majorant(m, "spectral MIS weights");
         if (murk_collisions_choice(&c, rng) < q[hero]) {
             for (int k = 0; k < 3; k++) {
-                ev->weight.c[k] *= dens * m->d->sigma_s.c[k] / (c.mu * q[hero]);
+                ev->weight.c[k] *= (fields && (m->fields & MURK_FIELD_ALBEDO) ? ss[k] : dens * m->d->sigma_s.c[k]) /
+                                   (c.mu * q[hero]);
                 ev->pdf_ratio.c[k] *= q[k] / q[hero];
             }
             ev->scattered = 1;
@@ -124,10 +152,22 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
             ev->weight.c[k] *= (1.0f - a[k]) / (1.0f - q[hero]);
             ev->pdf_ratio.c[k] *= (1.0f - q[k]) / (1.0f - q[hero]);
         }
+        if (np)
+            ev->null_prob *= 1.0f - q[hero];
         murk_collisions_raise(&c, amax);
     }
     if (c.stopped) /* the watchdog (murk/plugin.h) */
         murk_event_kill(ev, c.t);
+}
+
+static void smis_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
+                        murk_medium_event *ev)
+{
+    const smis *m = self;
+    if (m->base.fields || (m->base.d->integrator_minor >= MURK_ABI_MINOR_FIELDS && (ctx->flags & MURK_CTX_NULL_PROB)))
+        smis_flight(m, ray, ctx, rng, ev, 1);
+    else
+        smis_flight(m, ray, ctx, rng, ev, 0);
 }
 
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, smis_create, murk_tracker_free,

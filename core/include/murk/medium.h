@@ -67,7 +67,26 @@ typedef struct murk_medium_data {
      * murk_rng_float, as trackers built before it do. murk/tracking.h's murk_flight_* helpers and
      * murk_collisions do this. */
     int stratify_flights;
+    /* ABI 1.9 (read them only if MURK_HAS(size, murk_medium_data, integrator_minor)): */
+    uint32_t fields;           /* MURK_FIELD_*: the medium's fields beside density (below) */
+    uint32_t integrator_minor; /* the ABI minor of the scene's integrator: >= MURK_ABI_MINOR_FIELDS means it passes a
+                                * murk_medium_event with `emitted` and `null_prob` and a murk_path_ctx with
+                                * `pdf_ratio` and `flags`; a tracker writes or reads those only then */
 } murk_medium_data;
+
+/* Fields beside density (ABI 1.9), the scene's `albedo`, `emission` and `temperature` keys. Where a
+ * medium has none of them (fields == 0), sigma_a and sigma_s are the constants above, everywhere.
+ *   MURK_FIELD_ALBEDO    the single-scattering albedo varies in space: host->albedo(density, p) = a(p)
+ *                        per channel, and at p  sigma_s(p) = a(p) sigma_t(p),
+ *                        sigma_a(p) = (1 - a(p)) sigma_t(p),  with sigma_t(p) = density(p) (sigma_a +
+ *                        sigma_s) unchanged: the constants then give the extinction only.
+ *   MURK_FIELD_EMISSION  the medium emits: host->emission(density, p) = Le(p), radiance per unit
+ *                        absorption, so the source term is sigma_a(p) Le(p) per unit length (temperature
+ *                        fields arrive here as blackbody radiance). A tracker collects it along its free
+ *                        flights into ev->emitted (murk/tracking.h: murk_emit).
+ * murk refuses a medium with fields whose tracker was built before ABI 1.9 (it would ignore them), and
+ * emission with an integrator built before 1.9 (it would not collect it). */
+enum { MURK_FIELD_ALBEDO = 1u, MURK_FIELD_EMISSION = 2u };
 
 /* A walk over the majorant grid along a ray: consecutive segments [ta, tb) that tile the range given
  * to walk_init exactly, each with the maximum density over it (already multiplied by
@@ -80,13 +99,31 @@ typedef struct murk_medium_event {
     float t;            /* where it scattered (ray->tmax when it passed) */
     murk_rgb weight;    /* multiply into the path's beta (all 0: absorbed, the path ends) */
     murk_rgb pdf_ratio; /* multiply into the path's pdf ratios R: (1,1,1) except for per-channel trackers */
+    /* ABI 1.9 (only if the medium data's integrator_minor >= MURK_ABI_MINOR_FIELDS; the integrator sets emitted to 0 and
+     * null_prob to -1 before sample()): */
+    murk_rgb emitted;   /* the radiance the flight collected from an emitting medium, which the integrator
+                         * credits as beta * emitted / mean(R) with the path's beta and R before this flight
+                         * (murk_emit in murk/tracking.h computes it); stays 0 in media without emission */
+    float null_prob;    /* with MURK_CTX_NULL_PROB asked for: the product over the flight's tentative
+                         * collisions of the probability the hero channel's technique took the null branch
+                         * with (for a flight that passed the segment); -1: this tracker does not report it */
 } murk_medium_event;
 
 /* Per-path state an integrator passes to trackers. */
 typedef struct murk_path_ctx {
     int hero;        /* channel 0..2 chosen uniformly per path */
     murk_rgb beta;   /* the path's weight so far (history-aware probabilities use it) */
+    /* ABI 1.9 (only if the medium data's integrator_minor >= MURK_ABI_MINOR_FIELDS): */
+    murk_rgb pdf_ratio; /* the path's pdf ratios R so far (murk_emit needs them for spectral MIS) */
+    uint32_t flags;     /* MURK_CTX_*: what the integrator asks of this flight */
 } murk_path_ctx;
+
+/* MURK_CTX_NULL_PROB: report ev->null_prob, the null-collision probabilities of the flight, for path-level
+ * MIS of next-event estimation with free flights (Miller, Georgiev, Jarosz 2019, §5; volpath_nee's
+ * nee_mis). Only meaningful for a tracker whose tentative collisions are those of the majorant
+ * density max x max_k sigma_t,k and whose channel k technique takes a collision as null with
+ * probability 1 - sigma_t,k / majorant (spectral_mis). */
+enum { MURK_CTX_NULL_PROB = 1u };
 
 typedef struct murk_medium_vt {
     uint32_t size; /* sizeof(murk_medium_vt) of the plugin */

@@ -31,6 +31,10 @@
  * 1.8 (MURK_ABI_MINOR_LIGHTS) lets a light sample be at infinity
  * (dist = INFINITY) or of a delta light (murk_light_sample.flags, appended), and appends
  * murk_host.environment_pdf: escaped rays are MIS-weighted against the environment's light sampling.
+ * 1.9 (MURK_ABI_MINOR_FIELDS) adds the phase-function kind (murk/phase.h),
+ * murk_host's medium_phase_eval / medium_phase_sample / albedo / emission, murk_medium_data's fields and
+ * integrator_minor, murk_medium_event's emitted and null_prob, murk_path_ctx's pdf_ratio and flags
+ * (murk/medium.h: albedo and emission fields, volume emission).
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -62,10 +66,13 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 8
+#define MURK_ABI_MINOR 9
 /* The minor that brought infinite and delta light samples: an integrator built before it never gets one
  * (the core keeps such lights out of its light sampling and refuses a scene with delta lights for it). */
 #define MURK_ABI_MINOR_LIGHTS 8
+/* The minor that appended phase-function plugins and medium fields (the history below): plugins and the
+ * core compare another plugin's minor with it, never with a number. */
+#define MURK_ABI_MINOR_FIELDS 9
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
@@ -86,7 +93,8 @@ typedef enum murk_kind {
     MURK_KIND_MATERIAL = 1,
     MURK_KIND_MEDIUM = 2,
     MURK_KIND_INTEGRATOR = 3,
-    MURK_KIND_TRANSMITTANCE = 4 /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
+    MURK_KIND_TRANSMITTANCE = 4, /* ABI 1.2: transmittance estimators (murk/transmittance.h) */
+    MURK_KIND_PHASE = 5          /* ABI 1.9: phase functions (murk/phase.h) */
 } murk_kind;
 
 /* ---- Parameter schema ---------------------------------------------------------------------- */
@@ -217,6 +225,17 @@ typedef struct murk_host {
      * constant background: escaped rays count fully, as before). An escaped ray after a BSDF / phase
      * sample of pdf p adds background(dir) x power_heuristic(p, environment_pdf(dir)). */
     float (*environment_pdf)(const murk_scene *scene, murk_vec3 dir);
+    /* ABI 1.9: medium m's phase function (its `phase:` block, else Henyey-Greenstein of its g;
+     * murk/phase.h). medium_phase_eval is p(wo, wi) and the pdf of medium_phase_sample, which draws wi
+     * from the uniforms u, sets *pdf and returns the value p(wo, wi) (0: no sample). */
+    float (*medium_phase_eval)(const murk_medium *m, murk_vec3 wo, murk_vec3 wi);
+    float (*medium_phase_sample)(const murk_medium *m, murk_vec3 wo, const float u[2], murk_vec3 *wi, float *pdf);
+    /* ABI 1.9: a medium's fields beside its density at a world point (murk/medium.h: which a medium has is
+     * murk_medium_data.fields): the single-scattering albedo per channel, and the radiance Le emitted per
+     * unit absorption (the medium emits sigma_a(p) Le(p) per unit length). Each is one lookup, counted
+     * like a density lookup. */
+    murk_rgb (*albedo)(const murk_density *d, murk_vec3 p);
+    murk_rgb (*emission)(const murk_density *d, murk_vec3 p);
 } murk_host;
 
 /* Light sampling strategies (ABI 1.4). AREA: a triangle uniformly by area (a rectangular quad or box

@@ -20,6 +20,15 @@
 
 #include "murk/medium.h"
 
+/* Inlined wherever it is called, whatever the compiler's size heuristics: the collision loop's helpers, so
+ * that a tracker that writes its loop twice (see "Fields beside density" below) gets each instance with
+ * no call per collision. */
+#if defined(__GNUC__)
+#define MURK_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define MURK_ALWAYS_INLINE inline
+#endif
+
 /* What every tracker keeps; put it first in a tracker's own struct. */
 typedef struct murk_tracker {
     const murk_host *host;
@@ -28,6 +37,7 @@ typedef struct murk_tracker {
     float smax;       /* its largest channel */
     int grey;         /* 1 if sigma_t is the same in every channel */
     const char *plugin; /* the tracker's name for the watchdog's reports; set it after murk_tracker_new */
+    uint32_t fields;  /* the medium's fields beside density (MURK_FIELD_*, murk/medium.h; 0 before ABI 1.9) */
 } murk_tracker;
 
 /* Allocates a zeroed tracker struct of `size` bytes with the common part filled in. NULL (with err)
@@ -49,6 +59,7 @@ static inline void *murk_tracker_new(const murk_host *host, const murk_medium_da
     t->sigma_t = murk_rgb_add(d->sigma_a, d->sigma_s);
     t->smax = murk_rgb_max(t->sigma_t);
     t->grey = t->sigma_t.c[0] == t->sigma_t.c[1] && t->sigma_t.c[1] == t->sigma_t.c[2];
+    t->fields = MURK_HAS(d->size, murk_medium_data, integrator_minor) ? d->fields : 0;
     return t;
 }
 
@@ -101,7 +112,7 @@ static inline int murk_flight_stratified(const murk_medium_data *d)
 
 /* A uniform number in [0, 1): if *first (which it clears) the slot's — with sobol its first coordinate,
  * the second kept in *uc for murk_flight_choice — else the PCG stream's. */
-static inline float murk_flight_float(murk_rng *rng, int *first, float *uc)
+static MURK_ALWAYS_INLINE float murk_flight_float(murk_rng *rng, int *first, float *uc)
 {
     if (!*first)
         return murk_rng_float(rng);
@@ -122,7 +133,7 @@ static inline float murk_flight_exp(murk_rng *rng, int *first, float *uc, float 
 
 /* The number for a collision's choice: the slot's second coordinate if murk_flight_float left one in
  * *uc (which it clears), else the PCG stream's. */
-static inline float murk_flight_choice(murk_rng *rng, float *uc)
+static MURK_ALWAYS_INLINE float murk_flight_choice(murk_rng *rng, float *uc)
 {
     float u = *uc;
     *uc = -1.0f;
@@ -271,7 +282,7 @@ static inline void murk_collisions_raise(murk_collisions *c, float amax)
  * it was drawn with. Returns 0 when the ray's segment is used up — or when the watchdog stopped it
  * (c->stopped, reported once; the caller ends the path with murk_event_kill). Every iteration advances
  * t by at least one float or moves to the next cell, so the loop ends. */
-static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
+static MURK_ALWAYS_INLINE int murk_collisions_next(murk_collisions *c, murk_rng *rng, float *t, float *dens)
 {
     for (;;) {
         if (++c->steps > MURK_WATCHDOG_ITERATIONS) {
@@ -308,7 +319,75 @@ static inline int murk_collisions_next(murk_collisions *c, murk_rng *rng, float 
 /* The number for the choice at the collision murk_collisions_next() just returned (real or null,
  * absorbed or scattered): at the first collision of a stratified flight with sobol the slot's second
  * coordinate, else the PCG stream's. Draw it with this, not murk_rng_float. */
-static inline float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
+static MURK_ALWAYS_INLINE float murk_collisions_choice(murk_collisions *c, murk_rng *rng) { return murk_flight_choice(rng, &c->uc); }
+
+/* ---- Fields beside density (ABI 1.9; murk/medium.h) ---------------------------------------------------
+ * A medium with an albedo field or emission (t->fields != 0) needs more per collision than one without, so
+ * murk's trackers write their collision loop once as a MURK_ALWAYS_INLINE function with a constant flag
+ * and call it twice: the instance without fields is the loop as it always was (no lookups, no branches
+ * added per collision), chosen once per flight.
+ *
+ * Albedo: at a collision at p with density dens, murk_local_sigma gives the local sigma_a,k(p) and
+ * sigma_s,k(p) (with an albedo field a(p): a sigma_t,k dens and (1 - a) sigma_t,k dens); use them
+ * wherever the constants d->sigma_a, d->sigma_s times dens would be (scattering weights, spectral
+ * tracking's probabilities). Extinction, and so the majorants and null collisions, do not change.
+ *
+ * Emission: the collision estimator of pbrt-v4 (VolPathIntegrator): at EVERY tentative collision of the
+ * flight at p — null or real, before its choice — add  w_k sigma_a,k(p) Le_k(p) / mu  to the flight's
+ * emitted radiance, w the flight's running weight per channel and mu the rate the collision was drawn
+ * with. Tentative collisions are a Poisson process of rate mu, and a collision at t is reached with
+ * probability density mu(t) times the null-collision weights so far, whose expectation per channel is
+ * the transmittance T_k(t) (the running weights reweight every channel to its own); so the sum has
+ * expectation int T_k(t) sigma_a,k Le_k dt per channel, chromatic extinction included: unbiased, and it
+ * needs no probability of its own. (Scoring at real collisions only, weighted by sigma_a / sigma_t, is
+ * unbiased too, but in a thin flame real collisions are rare, while every null collision scores here.)
+ * Decomposition tracking's two processes together are one of rate control + residual; spectral MIS
+ * credits each score with the pdf ratios the path has at that collision (murk_emit's r). */
+/* 1 if the flight must collect emission: the medium emits and the integrator passes events that hold it. */
+static inline int murk_emitting(const murk_tracker *t)
+{
+    return (t->fields & MURK_FIELD_EMISSION) && t->d->integrator_minor >= MURK_ABI_MINOR_FIELDS;
+}
+
+/* a / b, 0 where b is 0 (a local albedo where the density vanishes). */
+static inline float murk_ratio0(float a, float b) { return b > 0.0f ? a / b : 0.0f; }
+
+/* The local absorption and scattering coefficients at p, density dens (see above). */
+static inline void murk_local_sigma(const murk_tracker *t, murk_vec3 p, float dens, float sa[3], float ss[3])
+{
+    if (t->fields & MURK_FIELD_ALBEDO) {
+        murk_rgb a = t->host->albedo(t->d->density, p);
+        for (int k = 0; k < 3; k++) {
+            float st = dens * t->sigma_t.c[k];
+            ss[k] = a.c[k] * st;
+            sa[k] = (1.0f - a.c[k]) * st;
+        }
+    } else {
+        for (int k = 0; k < 3; k++) {
+            sa[k] = dens * t->d->sigma_a.c[k];
+            ss[k] = dens * t->d->sigma_s.c[k];
+        }
+    }
+}
+
+/* The emission score of a tentative collision at p (see above): ev->emitted += w sa Le / mu, times
+ * mean(R) / mean(R r) with R the path's pdf ratios before the flight (ctx) and r the flight's pdf ratios up
+ * to this collision (ev->pdf_ratio for a tracker that keeps them there; 1 for trackers without per-channel
+ * techniques), so that the integrator's crediting (beta emitted / mean(R)) weights each score as spectral
+ * MIS weights a path ending there. */
+static inline void murk_emit(const murk_tracker *t, const murk_path_ctx *ctx, murk_medium_event *ev, murk_vec3 p,
+                             const float sa[3], float mu, murk_rgb w, murk_rgb r)
+{
+    murk_rgb le = t->host->emission(t->d->density, p);
+    float f = 1.0f / mu;
+    if (r.c[0] != 1.0f || r.c[1] != 1.0f || r.c[2] != 1.0f) {
+        murk_rgb R = ctx->pdf_ratio;
+        float m = R.c[0] + R.c[1] + R.c[2], mr = R.c[0] * r.c[0] + R.c[1] * r.c[1] + R.c[2] * r.c[2];
+        f = mr > 0.0f ? f * m / mr : 0.0f;
+    }
+    for (int k = 0; k < 3; k++)
+        ev->emitted.c[k] += w.c[k] * sa[k] * le.c[k] * f;
+}
 
 /* Ratio tracking (Novak et al. 2014) over (ray->tmin, ray->tmax) with majorant segments from the
  * walk; extra: a second density-proportional extinction that is handled in closed form instead
@@ -369,6 +448,59 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
             }
         }
     }
+    return T;
+}
+
+/* Plain ratio tracking for path-level MIS of next-event estimation with free flights (Miller, Georgiev,
+ * Jarosz 2019, §5; volpath_nee's nee_mis: null_scattering): tentative collisions at the free flights' own
+ * majorant, max density x max_c sigma_t,c per cell (no control), each multiplying channel c's estimate
+ * by 1 - sigma_t,c(x) / mu and *pnull (per channel) by the probability with which channel c's delta
+ * tracking would have taken that collision as null, 1 - murk_real_prob(a_c, 1 - a_c) — the same as the
+ * estimate's factor while the majorant bounds. Russian roulette (below 0.1, as murk_ratio_tracking)
+ * scales the estimate, never *pnull, which is a pdf of the path's null vertices, not an estimate. */
+static inline murk_rgb murk_ratio_tracking_null(const murk_host *h, const murk_medium_data *d, const murk_ray *ray,
+                                                murk_rng *rng, murk_rgb *pnull)
+{
+    murk_rgb st = murk_sigma_t(d), T = murk_rgb1(1.0f), P = murk_rgb1(1.0f);
+    float smax = murk_rgb_max(st);
+    if (!(smax > 0.0f)) {
+        *pnull = P;
+        return T;
+    }
+    murk_counters scratch, *count = murk_tracker_counters(h, d, &scratch);
+    murk_majorant_walk w;
+    h->walk_init(d->density, ray, ray->tmin, ray->tmax, &w);
+    float ta, tb, dmax, dmin;
+    long steps = 0;
+    while (h->walk_next(&w, &ta, &tb, &dmax, &dmin) && steps <= MURK_WATCHDOG_ITERATIONS) {
+        float mu = dmax * smax;
+        for (float t = ta; mu > 0.0f && ++steps <= MURK_WATCHDOG_ITERATIONS;) {
+            t = murk_advance(t, murk_sample_exp(rng, mu));
+            if (!(t < tb))
+                break;
+            count->collisions++;
+            float dens = h->density(d->density, murk_madd(ray->o, ray->d, t));
+            for (int k = 0; k < 3; k++) {
+                float a = dens * st.c[k] / mu;
+                T.c[k] *= 1.0f - a;
+                P.c[k] *= 1.0f - murk_real_prob(a, 1.0f - a);
+            }
+            float tm = fmaxf(fabsf(T.c[0]), fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
+            if (tm < 0.1f) { /* Russian roulette on the estimate only */
+                if (tm <= 0.0f || murk_rng_float(rng) >= tm) {
+                    *pnull = P;
+                    return murk_rgb1(0.0f);
+                }
+                T = murk_rgb_scale(T, 1.0f / tm);
+            }
+        }
+    }
+    if (steps > MURK_WATCHDOG_ITERATIONS) {
+        h->warn_once("medium '%s': ratio tracking exceeded %ld iterations (MURK_WATCHDOG_ITERATIONS); "
+                     "transmittance set to 0 (biased)", d->name, MURK_WATCHDOG_ITERATIONS);
+        T = murk_rgb1(0.0f);
+    }
+    *pnull = P;
     return T;
 }
 

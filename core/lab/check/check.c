@@ -47,6 +47,17 @@
  *                         says its estimates may be negative (the word "negative": murk/transmittance.h)
  *            An estimator biased by design (its description says "BIASED", as murk/transmittance.h asks)
  *            has its T figures printed and not judged (SKIP).
+ * phase      (a phase function, through the host's medium services as integrators call it) for the default
+ *            parameters and two more sets (param_set), wo fixed, N sampled directions:
+ *              chi2       sample() against eval(): the sphere cut into 16 x 32 cells around the forward
+ *                         direction, refined towards it as the mean cosine says (a peak of width ~1 - g spans
+ *                         several cells), expected counts by adaptive quadrature of eval() over each cell;
+ *                         fails below p = CK_P (1e-6), or if sample()'s pdf or value disagree with eval() (relative
+ *                         1e-3) for more than 1e-4 of the samples;
+ *              norm       the quadrature of eval() over the sphere is 1 within 1e-3;
+ *              reciprocity eval(a, b) = eval(b, a) for 4096 random pairs (relative 1e-4);
+ *              mean cos   if the plugin gives mean_cosine(): quadrature of eval() cos theta equals it within 1e-4,
+ *                         and the sampled directions' mean cosine within CK_Z standard errors.
  * integrator escaped camera rays return the background (an empty scene, exactly), and a furnace: the
  *            camera inside a closed box of inward-facing quads with albedo 0.5 and emission 0.5, where
  *            the radiance is 0.5 / (1 - 0.5) = 1 everywhere; the image mean must be 1 within CK_Z standard
@@ -61,6 +72,7 @@
  * decisions and the sum of their false-alarm probabilities. */
 #include "lab/check/sphere.h"
 #include "media/density.h"
+#include "media/media.h"
 #include "plugin/plugin_loader.h"
 #include "render/host.h"
 #include "scene/scene.h"
@@ -68,6 +80,7 @@
 #include "util/util.h"
 #include "murk/lab.h"
 #include "murk/murk.h"
+#include "murk/phase.h"
 
 #include <errno.h>
 #include <math.h>
@@ -870,6 +883,134 @@ static const char FURNACE_WALLS[] =
     "  - { type: quad, center: [0, 0, 1], u: [0, 1, 0], v: [1, 0, 0], material: wall, emission: 0.5%s }\n"
     "  - { type: quad, center: [0, 0, -1], u: [1, 0, 0], v: [0, 1, 0], material: wall, emission: 0.5%s }\n";
 
+/* ---- phase functions ----------------------------------------------------------------------------- */
+
+typedef struct ph_ref { const murk_host *h; const murk_medium *m; murk_vec3 wo; } ph_ref;
+
+static double ph_eval_at(void *vc, murk_vec3 w)
+{
+    const ph_ref *r = vc;
+    return r->h->medium_phase_eval(r->m, r->wo, w);
+}
+
+static double ph_cos_at(void *vc, murk_vec3 w)
+{
+    const ph_ref *r = vc;
+    return ph_eval_at(vc, w) * -(double)murk_dot(r->wo, w);
+}
+
+/* Draws n directions: cell counts on g (obs may be NULL), the mean cosine and its standard error, and how
+ * many samples disagree with eval() (pdf or value, relative 1e-3). */
+static long ph_sample(const ph_ref *r, const murk_sph_grid *g, long n, uint64_t seed, double *obs, double *mean,
+                      double *se)
+{
+    murk_rng rng;
+    murk_rng_seed(&rng, seed, 0x7068617365ull, 3);
+    double s1 = 0.0, s2 = 0.0;
+    long bad = 0;
+    for (long k = 0; k < n; k++) {
+        float u[2] = {murk_rng_float(&rng), murk_rng_float(&rng)}, pdf = 0.0f;
+        murk_vec3 wi = murk_v3(0, 0, 0);
+        float v = r->h->medium_phase_sample(r->m, r->wo, u, &wi, &pdf);
+        float e = r->h->medium_phase_eval(r->m, r->wo, wi);
+        if (!(pdf > 0.0f) || !isfinite(v) || fabs(murk_length(wi) - 1.0) > 1e-4 || rel_diff(pdf, e) > 1e-3 ||
+            rel_diff(v, e) > 1e-3) {
+            bad++;
+            continue;
+        }
+        double mu = -(double)murk_dot(r->wo, wi);
+        s1 += mu;
+        s2 += mu * mu;
+        if (obs)
+            obs[murk_sph_cell_of(g, wi)] += 1.0;
+    }
+    long good = n - bad > 1 ? n - bad : 2;
+    *mean = s1 / (double)good;
+    *se = sqrt(fmax(0.0, s2 / (double)good - *mean * *mean) / (double)(good - 1));
+    return bad;
+}
+
+static void check_phase_set(ck *c, const murk_medium *m, const char *label)
+{
+    const murk_phase *ph = murk_media_phase(m);
+    ph_ref r = {murk_host_table(), m, murk_normalize(murk_v3(0.3f, -0.5f, 0.8f))};
+    long n = c->quick ? 200000 : 1000000;
+    int has_mean = ph->vt && MURK_HAS(ph->vt->size, murk_phase_vt, mean_cosine) && ph->vt->mean_cosine;
+    double gbar = has_mean ? ph->vt->mean_cosine(ph->self) : 0.0, se;
+    if (!has_mean) /* a pilot run for the grid's refinement */
+        ph_sample(&r, NULL, 20000, c->seed, NULL, &gbar, &se);
+    /* refine towards the higher of the forward and backward peaks: a peak of height P spans about
+     * u = (1 - cos) / 2 < 1 / (16 pi P) (HG: P = (1 + g) / (4 pi (1 - g)^2)), put a quarter into the grid */
+    double pf = ph_eval_at(&r, murk_neg(r.wo)), pb = ph_eval_at(&r, r.wo), peak = fmax(pf, pb);
+    double up = fmin(0.25, fmax(1e-12, 1.0 / (16.0 * CK_PI * fmax(peak, 1e-30))));
+    murk_vec3 pole = pf >= pb ? murk_neg(r.wo) : r.wo;
+    murk_sph_grid g = {16, 32, pole, fmin(24.0, fmax(1.0, log(up) / log(0.25)))};
+    int nb = g.ntheta * g.nphi;
+    double *obs = calloc((size_t)nb, sizeof *obs), *expd = calloc((size_t)nb, sizeof *expd);
+    if (!obs || !expd) {
+        free(obs);
+        free(expd);
+        report(c, 0, "phase %s: out of memory", label);
+        return;
+    }
+    double mean;
+    long bad = ph_sample(&r, &g, n, c->seed, obs, &mean, &se);
+    double total = 0.0, terr = 0.0, tol = 0.02 / (double)n;
+    for (int it = 0; it < g.ntheta; it++)
+        for (int ip = 0; ip < g.nphi; ip++) {
+            double e = 0.0, v = murk_sph_integrate_cell(ph_eval_at, &r, &g, it, ip, tol, &e);
+            expd[it * g.nphi + ip] = v * (double)n;
+            total += v;
+            terr += e;
+        }
+    int dof = 0;
+    double p = murk_chi2_test(obs, expd, nb, 5.0, &dof);
+    stat_decisions(c, 1, CK_P);
+    report(c, p >= CK_P && bad <= n / 10000, "chi2        %-20s p = %-9.4g dof %3d  warp %.2f  eval/sample "
+           "mismatches %ld", label, p, dof, g.warp, bad);
+    report(c, fabs(total - 1.0) <= 1e-3 + terr, "norm        %-20s int p = %.6f (quadrature error %.1e)", label, total,
+           terr);
+    free(obs);
+    free(expd);
+    murk_rng rng;
+    murk_rng_seed(&rng, c->seed, 0x7265636970ull, 4);
+    double worst = 0.0;
+    for (int k = 0; k < 4096; k++) {
+        murk_vec3 a = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        murk_vec3 b = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        worst = fmax(worst, rel_diff(r.h->medium_phase_eval(m, a, b), r.h->medium_phase_eval(m, b, a)));
+    }
+    report(c, worst <= 1e-4, "reciprocity %-20s max rel difference %.1e over 4096 pairs", label, worst);
+    if (!has_mean) {
+        report(c, -1, "mean cos    %-20s no closed form (mean_cosine NULL); sampled %.5f +- %.5f", label, mean, se);
+        return;
+    }
+    double qe = 0.0, q = murk_sph_integrate(ph_cos_at, &r, &g, 1e-3 / (double)nb, &qe);
+    stat_decisions(c, 1, CK_ALPHA_Z);
+    report(c, fabs(q - gbar) <= 1e-4 + qe && fabs(mean - gbar) <= CK_Z * se + 1e-6,
+           "mean cos    %-20s closed form %.6f, quadrature %.6f, sampled %.5f +- %.5f", label, gbar, q, mean, se);
+}
+
+static void check_phase(ck *c, const murk_plugin_desc *d)
+{
+    for (int set = 0; set < 3; set++) {
+        char keys[2048], text[4096], err[1024], label[64];
+        if (!param_set(d, set, keys, sizeof keys))
+            continue;
+        snprintf(text, sizeof text, "murk: 1\nmedia:\n  m: { type: delta, phase: { type: %s%s } }\nshapes: []\n",
+                 d->name, keys);
+        murk_scene *s = load_text(c, "phase.yaml", text, err, sizeof err);
+        if (!s) {
+            report(c, 0, "create      %s: %s", set ? keys + 2 : "defaults", err);
+            continue;
+        }
+        printf("  parameters: %s\n", set ? keys + 2 : "defaults");
+        snprintf(label, sizeof label, "set %d", set);
+        check_phase_set(c, &s->media[0].m, label);
+        murk_scene_free(s);
+    }
+}
+
 static int render_scene(ck *c, const char *name, const char *text, murk_render_result *res, char *err, size_t errlen)
 {
     murk_scene *s = load_text(c, name, text, err, errlen);
@@ -1027,6 +1168,8 @@ static int check_one(ck *c, const char *arg)
         check_integrator(c, d);
     else if (d->kind == MURK_KIND_TRANSMITTANCE)
         check_transmittance(c, d);
+    else if (d->kind == MURK_KIND_PHASE)
+        check_phase(c, d);
     printf("%s: %s\n", d->name, c->fails == fails0 ? "all checks passed" : "FAILED");
     murk_registry_free(&reg);
     return c->fails == fails0 ? 0 : 1;
