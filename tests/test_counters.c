@@ -32,9 +32,9 @@ static void slab_closed_form(void **state)
         murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
         murk_path_ctx ctx = {0, murk_rgb1(1.0f)};
         murk_medium_event ev;
-        uint64_t before = murk_thread_counters[0].collisions;
+        uint64_t before = murk_thread_counters()[0].collisions;
         m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
-        double k = (double)(murk_thread_counters[0].collisions - before);
+        double k = (double)(murk_thread_counters()[0].collisions - before);
         sum += k;
         sum2 += k * k;
         scattered += ev.scattered != 0;
@@ -43,7 +43,7 @@ static void slab_closed_form(void **state)
     double expect = f * (1.0 - exp(-mu * L));
     printf("slab: %.5f tentative collisions per flight (closed form %.5f, se %.5f)\n", mean, expect, se);
     assert_true(fabs(mean - expect) < 4.0 * se);
-    const murk_counters *c = &murk_thread_counters[0];
+    const murk_counters *c = &murk_thread_counters()[0];
     assert_true(c->lookups == c->collisions);
     assert_true(c->scatters == scattered);
     double ps = 1.0 - exp(-mu * L), sp = sqrt(ps * (1.0 - ps) / n);
@@ -97,16 +97,16 @@ static void collisions_match_lookups(void **state)
                 murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
                 murk_path_ctx ctx = {mt_hero(&rng), murk_rgb1(1.0f)};
                 murk_medium_event ev;
-                uint64_t before = murk_thread_counters[e].collisions;
+                uint64_t before = murk_thread_counters()[e].collisions;
                 if (call == 0)
                     (void)murk_medium_transmittance(m, &ray, &ctx, &rng);
                 else
                     m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
-                double k = (double)(murk_thread_counters[e].collisions - before);
+                double k = (double)(murk_thread_counters()[e].collisions - before);
                 sum += k;
                 sum2 += k * k;
             }
-            const murk_counters *c = &murk_thread_counters[e];
+            const murk_counters *c = &murk_thread_counters()[e];
             printf("%-18s %-13s %9llu collisions %9llu lookups (%.4f per call)\n", est[e].label,
                    call ? "sample" : "transmittance", (unsigned long long)c->collisions,
                    (unsigned long long)c->lookups, sum / n);
