@@ -10,6 +10,7 @@ import ctypes
 import json
 import os
 import re
+import signal
 import threading
 
 import numpy as np
@@ -193,18 +194,29 @@ def _run_passes(ss):
 
 
 def _interruptible(work, name, stop):
-    """Runs work() on a thread of its own while this one waits; a KeyboardInterrupt (Ctrl-C) meanwhile calls
-    stop() and waits for work to return. 1 if it was interrupted."""
-    t = threading.Thread(target=work, name=name, daemon=True)
-    t.start()
-    interrupted = False
-    while t.is_alive():
-        try:
+    """Runs work() on a thread of its own while this one waits; Ctrl-C meanwhile calls stop() (thread-safe)
+    and keeps waiting for work to return, as SIGINT stops `murk render`. Python's SIGINT handler is replaced
+    for the wait (on the main thread, when it is Python's own: an ignored SIGINT stays ignored), so no
+    KeyboardInterrupt can leave a render running. True if it was interrupted."""
+    interrupted = []
+
+    def on_sigint(signum, frame):
+        interrupted.append(signum)
+        stop()
+
+    old = None
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        old = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        t = threading.Thread(target=work, name=name, daemon=True)
+        t.start()
+        while t.is_alive():
             t.join(0.05)
-        except KeyboardInterrupt:
-            interrupted = True
-            stop()
-    return interrupted
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGINT, old)
+    return bool(interrupted)
 
 
 def render(scene, spp=None, seed=None, threads=None, set=None, progress=None, time=None, base=None, quiet=False):
@@ -255,9 +267,9 @@ def _render_loaded(sc, spp, threads, time, progress):
         _lib.libc.free(ctypes.cast(res.rgb, ctypes.c_void_p))
     result = Result(image, res.seconds, res.spp, _counters(sc, res), _metadata(sc, res, spp),
                     bool(res.interrupted))
-    if failure:
+    if failure and not isinstance(failure[0], KeyboardInterrupt):
         raise failure[0]
-    if interrupted:
+    if interrupted or failure:  # Ctrl-C while the main thread waited, or while the callback ran
         e = KeyboardInterrupt("murk: render interrupted after %d spp" % res.spp)
         e.result = result
         raise e

@@ -146,6 +146,26 @@ def test_progress_and_stop():
     assert r.spp == 16
 
 
+def test_ctrl_c_stops_after_whole_passes():
+    """SIGINT (Ctrl-C) in a render: KeyboardInterrupt with .result, the image of the whole passes done."""
+    code = """if 1:
+        import os, signal, murk
+        tiny, sent = {"render.resolution": [12, 12]}, []
+        def ctrl_c(fraction, seconds, last):  # SIGINT to the process 0.2 s into the render
+            if seconds > 0.2 and not sent:
+                sent.append(os.kill(os.getpid(), signal.SIGINT))
+        try:
+            murk.render(%r, spp=1 << 22, set=tiny, time=120, progress=ctrl_c)
+            print("not interrupted")
+        except KeyboardInterrupt as e:
+            r = e.result
+            same = r.image.tobytes() == murk.render(%r, spp=r.spp, set=tiny).image.tobytes()
+            print("interrupted", r.interrupted, r.spp > 0, same)
+    """ % (SMOKE, SMOKE)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "interrupted True True True", out.stdout + out.stderr
+
+
 def test_compare():
     ref = murk.render(BOX, spp=16)
     a = murk.render(BOX, spp=2, seed=9)
