@@ -288,19 +288,21 @@ MURK_API int murk_lab_compare(int argc, char **argv)
     int rc = compare_options(&o, argc, argv);
     if (rc)
         return rc;
-    murk_lab_image LA = {0}, LB = {0};
-    murk_image A = {0}, B = {0};
     char err[1024];
     if (o.html && murk_html_check_path(o.html, err, sizeof err) != 0) { /* before any work */
         cli_error(err);
         return 1;
     }
-    if (murk_exr_read(o.a, &LA.im, err, sizeof err) || murk_exr_read(o.b, &LB.im, err, sizeof err)) {
+    int w, h;
+    const float *px;
+    murk_lab_image *LA = murk_lab_image_read(o.a, &w, &h, &px, err, sizeof err);
+    murk_lab_image *LB = LA ? murk_lab_image_read(o.b, &w, &h, &px, err, sizeof err) : NULL;
+    if (!LB) {
         cli_error(err);
-        murk_image_free(&LA.im);
+        murk_lab_image_free(LA);
         return 1;
     }
-    A = LA.im, B = LB.im;
+    const murk_image A = LA->im, B = LB->im;
     if (!o.cropped)
         o.crop = (murk_crop){0, 0, A.w, A.h};
     if (A.w != B.w || A.h != B.h) {
@@ -311,9 +313,9 @@ MURK_API int murk_lab_compare(int argc, char **argv)
                 o.crop.h, A.w, A.h);
         rc = 2;
     } else {
-        rc = compare_images(&o, &LA, &LB);
+        rc = compare_images(&o, LA, LB);
     }
-    murk_image_free(&A);
-    murk_image_free(&B);
+    murk_lab_image_free(LA);
+    murk_lab_image_free(LB);
     return rc;
 }
