@@ -35,9 +35,9 @@ static void slab_closed_form(void **state)
         murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
         murk_path_ctx ctx = {.hero = 0, .beta = murk_rgb1(1.0f)};
         murk_medium_event ev;
-        uint64_t before = murk_thread_counters[0].collisions;
+        uint64_t before = murk_thread_counters()[0].collisions;
         m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
-        double k = (double)(murk_thread_counters[0].collisions - before);
+        double k = (double)(murk_thread_counters()[0].collisions - before);
         sum += k;
         sum2 += k * k;
         scattered += ev.scattered != 0;
@@ -48,7 +48,7 @@ static void slab_closed_form(void **state)
     assert_true(stat_z_ok(mean, se, expect, 0.0));
     double zf = fabs(mean - 1.03 * expect) / se;
     assert_true(stat_must_fail("tentative collisions against a majorant 3% larger", zf > STAT_Z, zf));
-    const murk_counters *c = &murk_thread_counters[0];
+    const murk_counters *c = &murk_thread_counters()[0];
     assert_true(c->lookups == c->collisions);
     assert_true(c->scatters == scattered);
     double ps = 1.0 - exp(-mu * L), sp = sqrt(ps * (1.0 - ps) / n);
@@ -104,16 +104,16 @@ static void collisions_match_lookups(void **state)
                 murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, (float)L};
                 murk_path_ctx ctx = {.hero = mt_hero(&rng), .beta = murk_rgb1(1.0f)};
                 murk_medium_event ev;
-                uint64_t before = murk_thread_counters[e].collisions;
+                uint64_t before = murk_thread_counters()[e].collisions;
                 if (call == 0)
                     (void)murk_medium_transmittance(m, &ray, &ctx, &rng);
                 else
                     m->vt->sample(m->self, &ray, &ctx, &rng, &ev);
-                double k = (double)(murk_thread_counters[e].collisions - before);
+                double k = (double)(murk_thread_counters()[e].collisions - before);
                 sum += k;
                 sum2 += k * k;
             }
-            const murk_counters *c = &murk_thread_counters[e];
+            const murk_counters *c = &murk_thread_counters()[e];
             printf("%-18s %-13s %9llu collisions %9llu lookups (%.4f per call)\n", est[e].label,
                    call ? "sample" : "transmittance", (unsigned long long)c->collisions,
                    (unsigned long long)c->lookups, sum / n);

@@ -6,9 +6,10 @@ cd "$(dirname "$0")/.."
 BUILD=${MURK_BUILD_DIR:-build}
 
 # Build, test and data dependencies, all from Debian 12's own archive. chromium: the headless browser
-# the comparison page's test (tests/test_report_page.c) opens report.html in.
+# the comparison page's test (tests/test_report_page.c) opens report.html in. python3-numpy and
+# python3-pytest: the Python module (python/murk) and its tests; python3-yaml: one of those tests.
 PKGS="gcc meson ninja-build pkg-config cmake libembree-dev libopenexr-dev libyaml-dev libpng-dev
-      libcmocka-dev libnanovdb-dev glmark2-data python3 python3-matplotlib python3-numpy clang libclang-rt-14-dev
+      libcmocka-dev libnanovdb-dev glmark2-data python3 python3-matplotlib python3-numpy python3-pytest python3-yaml clang libclang-rt-14-dev
       openmpi-bin libopenmpi-dev chromium"
 missing=""
 for p in $PKGS; do

@@ -27,27 +27,56 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static const char *meta(const murk_image *im, const char *key)
+struct murk_lab_image {
+    murk_image im;
+};
+
+MURK_API murk_lab_image *murk_lab_image_read(const char *path, int *w, int *h, const float **rgb, char *err,
+                                            size_t errlen)
 {
-    for (int i = 0; i < im->nmeta; i++)
-        if (im->meta[i].key && !strcmp(im->meta[i].key, key))
-            return im->meta[i].value;
-    return NULL;
+    murk_lab_image *li = murk_xmalloc(sizeof *li);
+    if (murk_exr_read(path, &li->im, err, errlen) != 0) {
+        free(li);
+        return NULL;
+    }
+    *w = li->im.w, *h = li->im.h, *rgb = li->im.rgb;
+    return li;
 }
 
-/* The render's seconds (murk:render_time) and total density lookups (murk:counters), -1 if absent. */
-static double render_seconds(const murk_image *im)
+MURK_API const char *murk_lab_image_attr(const murk_lab_image *li, const char *key)
 {
-    const char *s = meta(im, "murk:render_time");
+    return murk_image_meta(&li->im, key);
+}
+
+MURK_API void murk_lab_image_free(murk_lab_image *li)
+{
+    if (li)
+        murk_image_free(&li->im);
+    free(li);
+}
+
+MURK_API double murk_lab_image_seconds(const murk_lab_image *li)
+{
+    const char *s = murk_image_meta(&li->im, "murk:render_time");
     char *end;
     double t = s ? strtod(s, &end) : -1;
     return s && end != s && t > 0 ? t : -1;
 }
 
-static double render_lookups(const murk_image *im)
+MURK_API double murk_lab_image_lookups(const murk_lab_image *li)
 {
-    const char *s = meta(im, "murk:counters"), *p = s ? strstr(s, "\"total\": {\"lookups\": ") : NULL;
+    const char *s = murk_image_meta(&li->im, "murk:counters"), *p = s ? strstr(s, "\"total\": {\"lookups\": ") : NULL;
     return p ? strtod(p + strlen("\"total\": {\"lookups\": "), NULL) : -1;
+}
+
+MURK_API void murk_lab_compare_figures(const float *a, const float *r, int w, murk_crop c, double seconds,
+                                       double lookups, murk_compare_figures *f)
+{
+    murk_metrics_compute(a, r, NULL, w, c, &f->m, NULL);
+    f->z = f->m.diff_se[3] > 0 ? f->m.diff[3] / f->m.diff_se[3] : 0.0;
+    f->seconds = seconds > 0 ? seconds : -1, f->lookups = lookups > 0 ? lookups : -1;
+    f->efficiency_time = f->seconds > 0 && f->m.relmse > 0 ? 1.0 / (f->m.relmse * f->seconds) : -1;
+    f->efficiency_lookups = f->lookups > 0 && f->m.relmse > 0 ? 1.0 / (f->m.relmse * f->lookups) : -1;
 }
 
 static int parse_crop(const char *v, murk_crop *c)
@@ -179,12 +208,7 @@ static int compare_options(compare_opts *o, int argc, char **argv)
     return !o->a || !o->b ? usage("compare needs two EXR files: TEST REFERENCE") : 0;
 }
 
-/* The figures of TEST against REFERENCE: the metrics, the bias test's z, and the efficiency from TEST's
- * render time (t) and density lookups (look), each -1 when unknown. */
-typedef struct figures {
-    murk_metrics m;
-    double z, t, look, eff_t, eff_l;
-} figures;
+typedef murk_compare_figures figures;
 
 /* The --json object (also the page's figures), malloc'd; NULL when out of memory. */
 static char *figures_json(const compare_opts *o, const figures *f)
@@ -202,10 +226,10 @@ static char *figures_json(const compare_opts *o, const figures *f)
            murk_cli_q(o->a), murk_cli_q(o->b), c->x, c->y, c->w, c->h, m->n, m->nonfinite, m->mse, m->relmse,
            m->relmse_se, m->mare, m->diff[0], m->diff[1], m->diff[2], m->diff[3], m->diff_se[0], m->diff_se[1],
            m->diff_se[2], m->diff_se[3], f->z);
-    if (f->t > 0)
-        fprintf(jf, ", \"seconds\": %.6g, \"efficiency_time\": %.9g", f->t, f->eff_t);
-    if (f->look > 0)
-        fprintf(jf, ", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", f->look, f->eff_l);
+    if (f->seconds > 0)
+        fprintf(jf, ", \"seconds\": %.6g, \"efficiency_time\": %.9g", f->seconds, f->efficiency_time);
+    if (f->lookups > 0)
+        fprintf(jf, ", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", f->lookups, f->efficiency_lookups);
     fprintf(jf, "}\n");
     fclose(jf);
     return js;
@@ -222,22 +246,19 @@ static void print_figures(const compare_opts *o, const figures *f)
            "%s\n", m->relmse_se, m->diff[3], m->diff_se[3], f->z, m->diff[0], m->diff[1], m->diff[2],
            fabs(f->z) < 3 ? "no sign of a different expected image (|z| < 3)"
                           : "the expected images differ (|z| >= 3: bias, or a reference of another scene)");
-    if (f->t > 0)
-        printf("efficiency 1/(relMSE x seconds) = %.4g (render time %.3g s, murk:render_time)\n", f->eff_t, f->t);
-    if (f->look > 0)
-        printf("efficiency 1/(relMSE x density lookups) = %.4g (%.0f lookups, murk:counters)\n", f->eff_l, f->look);
+    if (f->seconds > 0)
+        printf("efficiency 1/(relMSE x seconds) = %.4g (render time %.3g s, murk:render_time)\n", f->efficiency_time, f->seconds);
+    if (f->lookups > 0)
+        printf("efficiency 1/(relMSE x density lookups) = %.4g (%.0f lookups, murk:counters)\n", f->efficiency_lookups, f->lookups);
 }
 
 /* Two images of one size, the crop inside them: the figures (text or --json), then the --diff maps and
  * the --html page. The exit status. */
-static int compare_images(const compare_opts *o, const murk_image *A, const murk_image *B)
+static int compare_images(const compare_opts *o, const murk_lab_image *LA, const murk_lab_image *LB)
 {
+    const murk_image *A = &LA->im, *B = &LB->im;
     figures f;
-    murk_metrics_compute(A->rgb, B->rgb, NULL, A->w, o->crop, &f.m, NULL);
-    f.z = f.m.diff_se[3] > 0 ? f.m.diff[3] / f.m.diff_se[3] : 0.0;
-    f.t = render_seconds(A), f.look = render_lookups(A);
-    f.eff_t = f.t > 0 && f.m.relmse > 0 ? 1.0 / (f.m.relmse * f.t) : -1;
-    f.eff_l = f.look > 0 && f.m.relmse > 0 ? 1.0 / (f.m.relmse * f.look) : -1;
+    murk_lab_compare_figures(A->rgb, B->rgb, A->w, o->crop, murk_lab_image_seconds(LA), murk_lab_image_lookups(LA), &f);
     char *js = o->json || o->html ? figures_json(o, &f) : NULL, err[1024];
     int rc = 0;
     if (o->json)
@@ -249,7 +270,7 @@ static int compare_images(const compare_opts *o, const murk_image *A, const murk
     if (o->diff)
         rc = write_maps(o->diff, A->rgb, B->rgb, A->w, o->crop, o->scale, o->json);
     if (o->html && rc == 0) {
-        if (!js || murk_html_compare(o->html, o->a, o->b, A->rgb, B->rgb, A->w, &o->crop, js, f.t, f.look, err,
+        if (!js || murk_html_compare(o->html, o->a, o->b, A->rgb, B->rgb, A->w, &o->crop, js, f.seconds, f.lookups, err,
                                      sizeof err) != 0) {
             cli_error(js ? err : "out of memory");
             rc = 1;
@@ -267,17 +288,21 @@ MURK_API int murk_lab_compare(int argc, char **argv)
     int rc = compare_options(&o, argc, argv);
     if (rc)
         return rc;
-    murk_image A = {0}, B = {0};
     char err[1024];
     if (o.html && murk_html_check_path(o.html, err, sizeof err) != 0) { /* before any work */
         cli_error(err);
         return 1;
     }
-    if (murk_exr_read(o.a, &A, err, sizeof err) || murk_exr_read(o.b, &B, err, sizeof err)) {
+    int w, h;
+    const float *px;
+    murk_lab_image *LA = murk_lab_image_read(o.a, &w, &h, &px, err, sizeof err);
+    murk_lab_image *LB = LA ? murk_lab_image_read(o.b, &w, &h, &px, err, sizeof err) : NULL;
+    if (!LB) {
         cli_error(err);
-        murk_image_free(&A);
+        murk_lab_image_free(LA);
         return 1;
     }
+    const murk_image A = LA->im, B = LB->im;
     if (!o.cropped)
         o.crop = (murk_crop){0, 0, A.w, A.h};
     if (A.w != B.w || A.h != B.h) {
@@ -288,9 +313,9 @@ MURK_API int murk_lab_compare(int argc, char **argv)
                 o.crop.h, A.w, A.h);
         rc = 2;
     } else {
-        rc = compare_images(&o, &A, &B);
+        rc = compare_images(&o, LA, LB);
     }
-    murk_image_free(&A);
-    murk_image_free(&B);
+    murk_lab_image_free(LA);
+    murk_lab_image_free(LB);
     return rc;
 }

@@ -644,11 +644,11 @@ MURK_API int murk_scene_check_unused(const murk_scene *s, char *err, size_t errl
     return s->doc.root ? check_unused(s->doc.root, 0, err, errlen) : 0;
 }
 
-MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen)
+/* The scene of doc (read, or -1 with err already set), with the --set overrides. */
+static murk_scene *load_scene(murk_scene *s, int read, const char *const *sets, size_t nsets, char *err,
+                              size_t errlen)
 {
-    murk_scene *s = murk_xmalloc(sizeof *s);
-    murk_registry_init(&s->reg);
-    if (murk_ydoc_load_file(&s->doc, path, err, errlen) != 0) {
+    if (read != 0) {
         murk_scene_free(s);
         return NULL;
     }
@@ -663,4 +663,24 @@ MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, 
         return NULL;
     }
     return s;
+}
+
+static murk_scene *scene_new(void)
+{
+    murk_scene *s = murk_xmalloc(sizeof *s);
+    murk_registry_init(&s->reg);
+    return s;
+}
+
+MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen)
+{
+    murk_scene *s = scene_new();
+    return load_scene(s, murk_ydoc_load_file(&s->doc, path, err, errlen), sets, nsets, err, errlen);
+}
+
+MURK_API murk_scene *murk_scene_load_text(const char *text, const char *name, const char *const *sets, size_t nsets,
+                                          char *err, size_t errlen)
+{
+    murk_scene *s = scene_new();
+    return load_scene(s, murk_ydoc_load_string(&s->doc, text, name, err, errlen), sets, nsets, err, errlen);
 }

@@ -8,12 +8,8 @@
 
 #include "scene/scene.h"
 
-/* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
- * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the
- * camera; did you mean media.OTHER?" (or "--set ...: ..." for one a --set made). murk_scene_load itself
- * refuses only those a --set made (a misspelt name): embedders may load media and materials to call
- * them directly. Returns 0, or -1 with err. */
-int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
+/* murk_scene_check_unused (murk/murk.h): murk_scene_load itself refuses only the unused media and
+ * materials a --set made (a misspelt name); embedders may load media and materials to call them directly. */
 
 /* The content hash a checkpoint carries: the scene file and every file it loads (meshes, density
  * grids, image textures, as named after the --set overrides), each with its path; so a resume after

@@ -30,13 +30,13 @@ static void counted_sample(const void *self, const murk_ray *ray, const murk_pat
 {
     const counted *c = self;
     c->vt->sample(c->self, ray, ctx, rng, ev);
-    murk_thread_counters[c->slot].scatters += ev->scattered != 0;
+    murk_thread_counters()[c->slot].scatters += ev->scattered != 0;
 }
 
 static murk_rgb counted_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
 {
     const counted *c = self;
-    murk_thread_counters[c->slot].shadow++;
+    murk_thread_counters()[c->slot].shadow++;
     return c->vt->transmittance(c->self, ray, ctx, rng);
 }
 
@@ -45,7 +45,7 @@ static void counted_estimator_destroy(void *self) { (void)self; /* counted_destr
 static murk_rgb counted_estimate(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
 {
     const counted *c = self;
-    murk_thread_counters[c->slot].shadow++;
+    murk_thread_counters()[c->slot].shadow++;
     return c->tr_vt->estimate(c->tr_self, ray, ctx, rng);
 }
 

@@ -64,18 +64,18 @@ _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk t
 
 float murk_media_density(const murk_density *d, murk_vec3 p)
 {
-    murk_thread_counters[d->slot].lookups++;
+    murk_thread_counters()[d->slot].lookups++;
     return murk_field_eval(d->field, p);
 }
 
-murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_counters[d->slot]; }
+murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_counters()[d->slot]; }
 
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w)
 {
     walk *k = (walk *)(void *)w;
     murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
     k->factor = d->factor;
-    k->count = &murk_thread_counters[d->slot];
+    k->count = &murk_thread_counters()[d->slot];
 }
 
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
@@ -119,13 +119,13 @@ MURK_API const murk_phase *murk_media_phase(const murk_medium *m) { return &m->d
 
 murk_rgb murk_media_albedo(const murk_density *d, murk_vec3 p)
 {
-    murk_thread_counters[d->slot].lookups++;
+    murk_thread_counters()[d->slot].lookups++;
     return murk_fields_albedo(&d->fields, p);
 }
 
 murk_rgb murk_media_emission(const murk_density *d, murk_vec3 p)
 {
-    murk_thread_counters[d->slot].lookups++;
+    murk_thread_counters()[d->slot].lookups++;
     return murk_fields_emission(&d->fields, p);
 }
 

@@ -19,15 +19,6 @@
 #include <emmintrin.h>
 #endif
 
-/* initial-exec, like murk_thread_counters (runtime.h): a fixed offset from the thread pointer, where the
- * default model for a shared library's TLS calls __tls_get_addr on every access (every ray, here). */
-#if defined(__GNUC__)
-#define MURK_TLS_IE __attribute__((tls_model("initial-exec")))
-#else
-#define MURK_TLS_IE
-#endif
-static _Thread_local uint64_t thread_rays MURK_TLS_IE;
-
 /* The rays being recorded (murk_host_record_rays), or NULL: one predictable branch per ray otherwise. */
 static murk_ray_record *ray_record;
 
@@ -42,12 +33,11 @@ static void record_ray(const murk_ray *r, int occluded)
     }
 }
 
-uint64_t murk_host_thread_rays(void) { return thread_rays; }
+uint64_t murk_host_thread_rays(void) { return murk_tally()->rays; }
 
 void murk_host_thread_reset(void)
 {
-    thread_rays = 0;
-    murk_thread_counters_reset();
+    murk_thread_counters_reset(); /* the rays too */
 }
 
 static void *host_alloc(size_t n) { return calloc(1, n ? n : 1); }
@@ -159,7 +149,7 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
-    thread_rays++;
+    murk_tally()->rays++;
     if (ray_record)
         record_ray(r, 0);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
@@ -177,7 +167,7 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     struct RTCRay er;
     to_embree(r, &er);
     rtcOccluded1(s->rtc, &ctx, &er);
-    thread_rays++;
+    murk_tally()->rays++;
     if (ray_record)
         record_ray(r, 1);
     return er.tfar < 0.0f;

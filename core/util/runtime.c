@@ -63,14 +63,39 @@ MURK_API void murk_warn_summary(void)
     pthread_mutex_unlock(&warn_lock);
 }
 
-_Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
+_Thread_local murk_thread_tally *murk_tally_cache;
 
-void murk_thread_counters_reset(void) { memset(murk_thread_counters, 0, sizeof murk_thread_counters); }
+/* Each thread's tally is allocated on its first use and freed when the thread exits (the key's
+ * destructor): libmurk's own TLS is the cache pointer alone (runtime.h). */
+static pthread_key_t tally_key;
+static pthread_once_t tally_once = PTHREAD_ONCE_INIT;
+
+static void tally_free(void *t)
+{
+    free(t);
+    murk_tally_cache = NULL;
+}
+
+static int tally_key_ok;
+
+static void tally_key_create(void) { tally_key_ok = pthread_key_create(&tally_key, tally_free) == 0; }
+
+murk_thread_tally *murk_tally_first(void)
+{
+    pthread_once(&tally_once, tally_key_create);
+    murk_thread_tally *t = murk_xmalloc(sizeof *t); /* zeroed */
+    if (tally_key_ok) /* else (no key left) the tally outlives its thread: a leak, never a wrong count */
+        pthread_setspecific(tally_key, t);
+    return murk_tally_cache = t;
+}
+
+void murk_thread_counters_reset(void) { memset(murk_tally(), 0, sizeof(murk_thread_tally)); }
 
 void murk_thread_counters_add(murk_counters *sum, size_t n)
 {
+    const murk_thread_tally *t = murk_tally();
     for (size_t i = 0; i < n && i < MURK_COUNTER_SLOTS; i++) {
-        const murk_counters *c = &murk_thread_counters[i];
+        const murk_counters *c = &t->media[i];
         sum[i].lookups += c->lookups;
         sum[i].cells += c->cells;
         sum[i].collisions += c->collisions;

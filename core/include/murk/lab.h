@@ -43,6 +43,30 @@ typedef struct murk_metrics {
 void murk_metrics_compute(const float *a, const float *r, const float *v, int w, murk_crop c, murk_metrics *m,
                           float *pix);
 
+/* The figures `murk compare` prints of a (test) against r (reference): the metrics over the rectangle c, the
+ * bias test's z-score (mean difference over its standard error) and, from the test render's seconds and
+ * density lookups (each <= 0 when unknown), the efficiencies 1/(relMSE x seconds) and 1/(relMSE x lookups)
+ * (-1 when unknown or relMSE <= 0). */
+typedef struct murk_compare_figures {
+    murk_metrics m;
+    double z;
+    double seconds, lookups; /* as given, -1 when unknown */
+    double efficiency_time, efficiency_lookups;
+} murk_compare_figures;
+void murk_lab_compare_figures(const float *a, const float *r, int w, murk_crop c, double seconds, double lookups,
+                              murk_compare_figures *f);
+
+/* An EXR as `murk compare` reads it: 3 floats per pixel (row 0 at the top) and its string attributes
+ * (murk:render_time, murk:counters, ...). NULL with a one-line message in err. */
+typedef struct murk_lab_image murk_lab_image;
+murk_lab_image *murk_lab_image_read(const char *path, int *w, int *h, const float **rgb, char *err, size_t errlen);
+const char *murk_lab_image_attr(const murk_lab_image *im, const char *key); /* NULL if absent */
+void murk_lab_image_free(murk_lab_image *im);                             /* NULL is fine */
+/* The render's seconds (murk:render_time) and total density lookups (murk:counters) an EXR records, -1 if
+ * absent: what murk_lab_compare_figures takes. */
+double murk_lab_image_seconds(const murk_lab_image *im);
+double murk_lab_image_lookups(const murk_lab_image *im);
+
 /* ---- A bench, row by row ---- */
 
 /* One row of bench.csv (its columns, in order): a whole render, its work and its figures against the
@@ -94,5 +118,8 @@ void murk_lab_plugin_close(murk_lab_plugin *plugin); /* NULL is fine */
  * the order `murk plugins TRACKER` lists them. Two more are not of a schema's types: `density` (a map)
  * and `transmittance` (an estimator's name, or a map with its `type`). */
 const murk_param *murk_lab_medium_params(uint32_t *n);
+/* The names of the plugins on the search path (NAME for NAME.so, a name found twice once), sorted, one per
+ * line; malloc'd (free() it), NULL when out of memory. */
+char *murk_lab_plugin_names(void);
 
 #endif

@@ -56,7 +56,30 @@ typedef struct murk_render_result {
  * --set creates and nothing uses is refused (a misspelt name). The murk command also refuses the scene
  * file's own unused media and materials; this function loads them, for embedders that call them. */
 murk_scene *murk_scene_load(const char *path, const char *const *sets, size_t nsets, char *err, size_t errlen);
+/* The same from YAML text in memory (a binding's scene built as data): name stands for the file, in
+ * messages ("NAME:LINE:COL: ...") and as the folder that the scene's relative paths (meshes, grids,
+ * textures) start from. */
+murk_scene *murk_scene_load_text(const char *text, const char *name, const char *const *sets, size_t nsets,
+                                 char *err, size_t errlen);
 void murk_scene_free(murk_scene *scene);
+/* The murk command's rule for a loaded scene, which murk_scene_load leaves to its caller: a medium or
+ * material that no shape (and, for a medium, not the camera) uses is an error, "FILE:LINE:COL: media.NAME
+ * is not used by any shape or by the camera; did you mean media.OTHER?". 0, or -1 with err. */
+int murk_scene_check_unused(const murk_scene *scene, char *err, size_t errlen);
+
+/* What a loaded scene is: its render block, integrator and media (a binding's result metadata). */
+typedef struct murk_scene_info {
+    int width, height, spp; /* render.resolution and render.spp */
+    uint64_t seed;          /* render.seed */
+    float exposure;         /* render.exposure (the PNG preview's) */
+    const char *integrator; /* its plugin's name; lives as long as the scene */
+    int nmedia;             /* murk_render_result.media's blocks are these media's, in this order */
+} murk_scene_info;
+void murk_scene_get_info(const murk_scene *scene, murk_scene_info *info);
+/* The i-th medium's name (0 <= i < nmedia), or NULL. */
+const char *murk_scene_medium_name(const murk_scene *scene, int i);
+/* The plugins the scene loaded, as the EXR's murk:plugins lists them, into buf (n bytes); the length. */
+size_t murk_scene_plugins(const murk_scene *scene, char *buf, size_t n);
 /* Renders the scene: murk_session_begin, murk_session_run_pass until it returns 0 or -1, murk_session_end
  * (below); in passes only when opts asks for them (time_limit, stop, checkpoint), else in one. 0, or -1
  * with a one-line message in err (an output that cannot be written, found before the first sample; a
@@ -79,10 +102,7 @@ int murk_render_err(const murk_scene *scene, const murk_render_opts *opts, murk_
  * each (or fill opts->time_limit), so a stop loses at most one. The image depends on the scene, seed and
  * spp only, however the render was cut into passes, stopped and resumed. Under MPI every rank calls the
  * same functions; rank 0 decides the passes, takes the stops and alone gets the image.
- * libmurk keeps per-thread counters in initial-exec TLS (fast, but from glibc's small static reserve): a
- * process that dlopen()s libmurk after it started (ctypes.CDLL) must be started with
- * GLIBC_TUNABLES=glibc.rtld.optional_static_tls=8192 (or LD_PRELOAD=libmurk.so), else dlopen fails with
- * "cannot allocate memory in static TLS block". */
+ * A program may dlopen() libmurk after it started (Python's ctypes): its thread-local state is one pointer. */
 typedef struct murk_session murk_session;
 /* Progress: the share of this run's samples done (0..1; a resumed checkpoint's not counted), seconds since
  * the passes began, last = 1 on the final call (from murk_session_end). Called on the thread that runs
