@@ -89,10 +89,14 @@ def write_atomic(path, write):
         raise
 
 
-def save(fig, d, name):
+def save(fig, d, name, meta=None):
+    """PNG and SVG; the PNG carries murk's text keys murk:commit and murk:version (from bench.json)."""
     for ext in ("png", "svg"):
+        md = None
+        if ext == "png" and meta:
+            md = {"murk:commit": str(meta.get("commit", "unknown")), "murk:version": str(meta.get("version", "unknown"))}
         write_atomic(os.path.join(d, name + "." + ext),
-                     lambda tmp: fig.savefig(tmp, format=ext, dpi=110, bbox_inches="tight"))
+                     lambda tmp: fig.savefig(tmp, format=ext, dpi=110, bbox_inches="tight", metadata=md))
     plt.close(fig)
 
 
@@ -126,7 +130,7 @@ def error_chart(d, meta, agg, cost, xlabel, name):
     ax.grid(True, which="both", alpha=0.3)
     if not empty:
         ax.legend(fontsize=8)
-    save(fig, d, name)
+    save(fig, d, name, meta)
 
 
 def efficiency_chart(d, meta, agg):
@@ -157,7 +161,7 @@ def efficiency_chart(d, meta, agg):
         ax.set_ylabel("efficiency relative to '%s'" % meta["variants"][0])
         ax.set_title(title, fontsize=10)
         ax.legend(fontsize=8)
-    save(fig, d, "efficiency")
+    save(fig, d, "efficiency", meta)
 
 
 def box_blur(a, r):
@@ -198,7 +202,7 @@ def efficiency_map(d, meta, agg):
         if flat.any():
             handles.append(Patch(color=(0.5, 0.5, 0.5), label="no error in any variant (%.0f%%)" % (100 * flat.mean())))
         ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.02), ncol=2)
-    save(fig, d, "efficiency_map")
+    save(fig, d, "efficiency_map", meta)
     return shares
 
 

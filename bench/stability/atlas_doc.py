@@ -1,5 +1,8 @@
 """docs/stability.md and its heat maps from the atlas rows (bench/stability/atlas.py)."""
-import math, os
+import math, os, sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tools"))
+import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
 
 import numpy as np
 
@@ -70,7 +73,7 @@ def heatmaps(root, rows, sweep, title):
     fig.tight_layout()
     os.makedirs(os.path.join(root, "docs", FIG_DIR), exist_ok=True)
     rel = "%s/%s.png" % (FIG_DIR, sweep)
-    fig.savefig(os.path.join(root, "docs", rel), dpi=80)
+    fig.savefig(os.path.join(root, "docs", rel), dpi=80, metadata=pngmeta.metadata())
     plt.close(fig)
     return rel
 

@@ -175,7 +175,7 @@ static int meta_fill(FILE *f, const char *tmp, void *user, char *err, size_t err
     }
     fprintf(f, "{\n  \"command\": ");
     json_str(f, cmd);
-    fprintf(f, ",\n  \"version\": \"%s\",\n  \"scene\": ", MURK_VERSION);
+    fprintf(f, ",\n  \"version\": \"%s\",\n  \"commit\": \"%s\",\n  \"scene\": ", MURK_VERSION, murk_build_commit());
     json_str(f, b->scene);
     fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %d,\n",
             b->time_mode ? "seconds" : "spp", b->repeat, b->threads, murk_cpus_usable());

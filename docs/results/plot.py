@@ -17,6 +17,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tools"))
+import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
+
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
 build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
@@ -54,6 +57,6 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
     axes[1].legend(fontsize=7, loc="lower left")
     fig.suptitle(f"{scene}: shadow-ray transmittance, error vs cost (bench/transmittance, {nseg} segments x {nest})")
     fig.tight_layout()
-    fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90)
+    fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90, metadata=pngmeta.metadata())
     plt.close(fig)
 print(out, end="")
