@@ -5,7 +5,8 @@
 #
 #   scenes/glass.sh            # about 4 minutes on 2 busy cores
 #
-# Environment: MURK (default ./build/core/murk), T (seconds per variant, default 15), REF_T (seconds of
+# Environment: MURK (default ./build/core/murk), DOCS (the docs folder, default docs; strips to DOCS/glass), OUT
+# (renders, default out/glass), T (seconds per variant, default 15), REF_T (seconds of
 # each reference, default 60; seed 1), REUSE=1 (keep finished renders), PYTHON (default /usr/bin/python3,
 # with python3-matplotlib for bench/strip.py). Every render runs under `nice -n 10`, 256x256.
 set -euf   # -f: no globbing, the [W,H] in --set values stay literal
@@ -14,8 +15,8 @@ MURK=${MURK:-./build/core/murk}
 PYTHON=${PYTHON:-/usr/bin/python3}
 T=${T:-15}
 REF_T=${REF_T:-60}
-OUT=out/glass
-DOC=docs/glass
+OUT=${OUT:-out/glass}
+DOC=${DOCS:-docs}/glass
 mkdir -p "$OUT" "$DOC"
 TABLE=$OUT/results.txt
 printf 'image\tspp\tseconds\trelMSE\n' > "$TABLE"

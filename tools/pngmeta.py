@@ -38,3 +38,30 @@ def metadata():
         except OSError:
             commit = "unknown"
     return {"murk:commit": commit, "murk:version": version or "unknown"}
+
+
+def stamp(path, meta=None):
+    """Adds the text keys to a PNG another program wrote (a browser's screenshot): tEXt chunks right
+    after IHDR, the file rewritten through a temporary renamed over it."""
+    import struct
+    import zlib
+    meta = meta or metadata()
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError("%s: not a PNG file" % path)
+    ihdr_end = 8 + 12 + struct.unpack(">I", data[8:12])[0]
+    chunks = b""
+    for k, v in meta.items():
+        body = k.encode("latin-1") + b"\0" + v.encode("latin-1", "replace")
+        chunks += struct.pack(">I", len(body)) + b"tEXt" + body + struct.pack(">I", zlib.crc32(b"tEXt" + body))
+    tmp = "%s.tmp-%d" % (path, os.getpid())
+    with open(tmp, "wb") as f:
+        f.write(data[:ihdr_end] + chunks + data[ihdr_end:])
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":  # pngmeta.py FILE.png...: stamps each with murk's text keys
+    import sys
+    for p in sys.argv[1:]:
+        stamp(p)
