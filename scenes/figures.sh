@@ -53,7 +53,7 @@ render() {
 
 # relmse NAME REF : relMSE of $OUT/NAME.exr against $OUT/REF.exr, appended to the results table
 relmse() {
-  r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '{print $4}')
+  r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '/^MSE/ {print $4}')
   set -- "$1" "$2" "$r" $(cat "$OUT/$1.stats")
   printf '%s\t%s\t%s\t%s\n' "$1" "$4" "$5" "$3" >> "$TABLE"
   printf '%s' "$3"

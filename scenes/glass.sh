@@ -44,7 +44,7 @@ for scene in juice cloud; do
   : > "$list"
   for tr in delta spectral spectral_mis; do
     render "${scene}_$tr" "scenes/glass_$scene.yaml" --time "$T" --spp 100000 --set "media.$medium.type=$tr"
-    r=$("$MURK" compare "$OUT/${scene}_$tr.exr" "$OUT/${scene}_ref.exr" | awk '{print $4}')
+    r=$("$MURK" compare "$OUT/${scene}_$tr.exr" "$OUT/${scene}_ref.exr" | awk '/^MSE/ {print $4}')
     set -- $(cat "$OUT/${scene}_$tr.stats")
     printf '%s\t%s\t%s\t%s\n' "${scene}_$tr" "$1" "$2" "$r" >> "$TABLE"
     printf '%s\n' "$OUT/${scene}_$tr.png:$tr\\n$1 spp, $2 s\\nrelMSE $r" >> "$list"
