@@ -2,6 +2,7 @@
 """Regenerates docs/results/transmittance.csv and the transmittance_*.png charts of docs/results.md.
 
     /usr/bin/python3 docs/results/plot.py [BUILD_DIR] [SEGMENTS] [ESTIMATES]   (defaults: build 200 1000)
+    /usr/bin/python3 docs/results/plot.py --from-csv docs/results/transmittance.csv   (the charts only)
 
 Runs BUILD_DIR/bench/transmittance (see bench/transmittance.c), keeps its CSV, and draws per scene the
 error of the mean of n estimates, sqrt(bias^2 + var / n) averaged over the channels' MSE, against the
@@ -26,13 +27,18 @@ root = os.path.dirname(os.path.dirname(here))
 if os.environ.get("MURK_DOCS_DIR"):
     here = os.path.join(os.environ["MURK_DOCS_DIR"], "results")
     os.makedirs(here, exist_ok=True)
-build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
-nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
-nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
-out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
-                     capture_output=True, text=True).stdout
-with open(os.path.join(here, "transmittance.csv"), "w") as f:
-    f.write(out)
+if len(sys.argv) > 2 and sys.argv[1] == "--from-csv":  # redraw the charts from a CSV measured before
+    with open(sys.argv[2]) as f:
+        out = f.read()
+    nseg, nest = "200", "1000"
+else:
+    build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
+    nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
+    nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
+    out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
+                         capture_output=True, text=True).stdout
+    with open(os.path.join(here, "transmittance.csv"), "w") as f:
+        f.write(out)
 rows = list(csv.DictReader(out.splitlines()))
 # one colour and one marker per estimator, never shared: tab10's ten colours, then tab20's darker half;
 # solid lines for the unbiased estimators, dashed for the biased raymarch baselines
