@@ -83,7 +83,7 @@ figure2() {
   "$MURK" compare "$OUT/bunny_control0.exr" "$OUT/bunny_delta.exr" --diff "$OUT/bunny_diff.png" \
     | tee "$OUT/bunny_diff.txt"
   rel=$(awk '/^MSE/ {print $4}' "$OUT/bunny_diff.txt")
-  white=$(sed -n 's/.*99th percentile (\(.*\))$/\1/p' "$OUT/bunny_diff.txt")
+  white=$(sed -n 's/.*99th percentile (\([^)]*\)).*/\1/p' "$OUT/bunny_diff.txt" | head -n 1)
   "$PYTHON" bench/strip.py --title "Figure 2: decomposition at control 0 vs delta tracking" "$DOC/fig2_bunny.png" \
     "$OUT/bunny_control0.png:$(caption bunny_control0 'decomposition, control 0')" \
     "$OUT/bunny_delta.png:$(caption bunny_delta 'delta tracking')" \
