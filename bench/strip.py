@@ -5,7 +5,11 @@
 
 A caption may hold several lines separated by a literal "\\n" (e.g. 'delta\\n64 spp, 10.1 s\\nrelMSE 0.012').
 Images of different sizes are centred in equal-width panels. Needs Debian's python3-matplotlib."""
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools"))
+import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.image as mpimg
@@ -46,4 +50,4 @@ for k, (img, caption) in enumerate(items):
     ax.axis("off")
     fig.text((PAD + k * (pw + PAD) + pw / 2) / W, (cap_h - PAD / 2) / H, caption, ha="center", va="top",
              fontsize=9, linespacing=1.25)
-fig.savefig(out, dpi=DPI, facecolor="white")
+fig.savefig(out, dpi=DPI, facecolor="white", metadata=pngmeta.metadata())

@@ -5,24 +5,32 @@
 #
 #   scenes/figures.sh [FIGURE ...]      # figures 1..5, default: 2 3 4 5
 #
-#   1  GGX roughness and albedo/specular rows (docs/ggx_*.png; rendered into out/gallery only)
-#   2  Cornell box + bunny: decomposition at control 0 beside delta tracking, and their difference
+#   1  GGX roughness rows, murk's scale and the report's (alpha:), and albedo/specular (docs/ggx_*.png)
+#   2  Cornell box + bunny: decomposition at control 0 beside delta tracking (transmittance: ratio on
+#      both, so the two make the same decisions), and their difference
 #   3  cornell_smoke with decomposition: majorant x1.01, x1.1, x2, x4 and control 0.5, 0.1 (equal spp)
-#   4  the three spectral scenes with naive_spectral, spectral, spectral_mis at equal time
+#   4  the three spectral scenes on heterogeneous media: the report's three-pass naive baseline, murk's
+#      hero-per-path naive, spectral, spectral_mis, in interleaved timed rounds (bench/figure4.py)
 #   5  the final scene, scenes/axe_room.yaml
 #
-# Every render runs under `nice -n 10` with murk's default thread count. Environment: MURK (the murk
-# executable, default ./build/core/murk), REUSE=1 (keep renders already in out/gallery and only
-# recompute the comparisons and strips), PYTHON (default /usr/bin/python3, needs python3-matplotlib
-# for bench/strip.py). The whole default run takes about 12 minutes on an idle 2-core machine.
+# Every render but figure 4's (timed) runs under `nice -n 10` with murk's default thread count.
+# Environment: MURK (the murk executable, default ./build/core/murk), SCALE (multiplies every spp,
+# default 1; tools/docs.sh passes its --scale), DOCS (the docs folder written, default docs; the strips go
+# to DOCS/gallery), OUT (renders, logs, tables; default out/gallery), REUSE=1 (keep renders already in
+# OUT and only recompute the comparisons and strips), PYTHON (default /usr/bin/python3, needs
+# python3-matplotlib for bench/strip.py). Normally run through tools/docs.sh, which regenerates all of docs/.
 set -euf   # -f: no globbing, the [W,H] in --set values stay literal
 cd "$(dirname "$0")/.."
 MURK=${MURK:-./build/core/murk}
 PYTHON=${PYTHON:-/usr/bin/python3}
-OUT=out/gallery
-DOC=docs/gallery
-RES=256                       # figures 2-4: 256x256
-REF_SPP=512                   # references for relMSE (figures 3, 4): 8x the spp of a 64-spp variant,
+SCALE=${SCALE:-1}
+DOCS=${DOCS:-docs}
+OUT=${OUT:-out/gallery}
+DOC=$DOCS/gallery
+RES=256                       # figures 2-3: 256x256
+# n N: N spp times SCALE, at least 1
+n() { awk -v n="$1" -v s="$SCALE" 'BEGIN { v = int(n * s + 0.5); print (v < 1 ? 1 : v) }'; }
+REF_SPP=$(n 512)              # references for relMSE (figure 3): 8x the spp of a 64-spp variant,
                               # seed 1: independent of the variants' seed-0 samples
 mkdir -p "$OUT" "$DOC"
 TABLE=$OUT/results.txt
@@ -45,7 +53,7 @@ render() {
 
 # relmse NAME REF : relMSE of $OUT/NAME.exr against $OUT/REF.exr, appended to the results table
 relmse() {
-  r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '{print $4}')
+  r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '/^MSE/ {print $4}')
   set -- "$1" "$2" "$r" $(cat "$OUT/$1.stats")
   printf '%s\t%s\t%s\t%s\n' "$1" "$4" "$5" "$3" >> "$TABLE"
   printf '%s' "$3"
@@ -60,20 +68,22 @@ caption() {
 }
 
 figure1() {
-  for s in ggx_roughness ggx_albedo_specular; do
-    render "$s" "scenes/$s.yaml" --spp 256
+  for s in ggx_roughness ggx_roughness_alpha ggx_albedo_specular; do
+    render "$s" "scenes/$s.yaml" --spp "$(n 256)"
+    cp "$OUT/$s.png" "$DOCS/$s.png"
   done
 }
 
 figure2() {
   S=scenes/cornell_bunny.yaml
-  render bunny_delta $S --spp 128 --set render.resolution=[$RES,$RES] --set media.smoke.type=delta
-  render bunny_control0 $S --spp 128 --set render.resolution=[$RES,$RES] \
-    --set media.smoke.type=decomposition --set media.smoke.control=0
+  render bunny_delta $S --spp "$(n 128)" --set render.resolution=[$RES,$RES] --set media.smoke.type=delta \
+    --set media.smoke.transmittance=ratio
+  render bunny_control0 $S --spp "$(n 128)" --set render.resolution=[$RES,$RES] \
+    --set media.smoke.type=decomposition --set media.smoke.control=0 --set media.smoke.transmittance=ratio
   "$MURK" compare "$OUT/bunny_control0.exr" "$OUT/bunny_delta.exr" --diff "$OUT/bunny_diff.png" \
     | tee "$OUT/bunny_diff.txt"
   rel=$(awk '/^MSE/ {print $4}' "$OUT/bunny_diff.txt")
-  white=$(sed -n 's/.*99th percentile (\(.*\))$/\1/p' "$OUT/bunny_diff.txt")
+  white=$(sed -n 's/.*99th percentile (\([^)]*\)).*/\1/p' "$OUT/bunny_diff.txt" | head -n 1)
   "$PYTHON" bench/strip.py --title "Figure 2: decomposition at control 0 vs delta tracking" "$DOC/fig2_bunny.png" \
     "$OUT/bunny_control0.png:$(caption bunny_control0 'decomposition, control 0')" \
     "$OUT/bunny_delta.png:$(caption bunny_delta 'delta tracking')" \
@@ -84,11 +94,11 @@ figure3() {
   S=scenes/cornell_smoke.yaml
   R="--set render.resolution=[$RES,$RES]"
   render smoke_reference $S --spp $REF_SPP $R --set media.smoke.type=delta --set render.seed=1
-  D="--spp 64 $R --set media.smoke.type=decomposition"
+  D="--spp $(n 64) $R --set media.smoke.type=decomposition"
   render smoke_m1 $S $D
   for f in 1.01 1.1 2 4; do render "smoke_m$f" $S $D --set media.smoke.majorant_factor=$f; done
   for c in 0.5 0.1; do render "smoke_c$c" $S $D --set media.smoke.control=$c; done
-  "$PYTHON" bench/strip.py --title "Figure 3: decomposition tracking, looser majorants and lower control (64 spp each)" \
+  "$PYTHON" bench/strip.py --title "Figure 3: decomposition tracking, looser majorants and lower control ($(n 64) spp each)" \
     "$DOC/fig3_majorant_control.png" \
     "$OUT/smoke_m1.png:$(caption smoke_m1 'majorant x1, control 1' smoke_reference)" \
     "$OUT/smoke_m1.01.png:$(caption smoke_m1.01 'majorant x1.01' smoke_reference)" \
@@ -99,25 +109,12 @@ figure3() {
     "$OUT/smoke_c0.1.png:$(caption smoke_c0.1 'control 0.1' smoke_reference)"
 }
 
-figure4() {
-  T=6                          # seconds per render
-  R="--set render.resolution=[$RES,$RES]"
-  for s in absorption scattering extinction; do
-    S=scenes/spectral_$s.yaml
-    render "${s}_reference" $S --spp $REF_SPP $R --set media.medium.type=spectral_mis \
-      --set render.seed=1
-    for t in naive_spectral spectral spectral_mis; do
-      render "${s}_$t" $S --time $T --spp 1000000 $R --set media.medium.type=$t
-    done
-    "$PYTHON" bench/strip.py --title "Figure 4 ($s): equal time, $T s each" "$DOC/fig4_$s.png" \
-      "$OUT/${s}_naive_spectral.png:$(caption "${s}_naive_spectral" 'naive per-channel' "${s}_reference")" \
-      "$OUT/${s}_spectral.png:$(caption "${s}_spectral" 'spectral tracking' "${s}_reference")" \
-      "$OUT/${s}_spectral_mis.png:$(caption "${s}_spectral_mis" 'spectral MIS' "${s}_reference")"
-  done
+figure4() {   # timed: not niced; the table is spliced into DOCS/gallery.md
+  "$PYTHON" bench/figure4.py --scale "$SCALE" --rounds "${ROUNDS:-5}" --out "$OUT/fig4" --docs "$DOC" --md "$DOCS/gallery.md"
 }
 
 figure5() {
-  render axe_room scenes/axe_room.yaml --spp 256
+  render axe_room scenes/axe_room.yaml --spp "$(n 256)"
   cp "$OUT/axe_room.png" "$DOC/axe_room.png"
 }
 

@@ -5,7 +5,8 @@
 #
 #   scenes/glass.sh            # about 4 minutes on 2 busy cores
 #
-# Environment: MURK (default ./build/core/murk), T (seconds per variant, default 15), REF_T (seconds of
+# Environment: MURK (default ./build/core/murk), DOCS (the docs folder, default docs; strips to DOCS/glass), OUT
+# (renders, default out/glass), T (seconds per variant, default 15), REF_T (seconds of
 # each reference, default 60; seed 1), REUSE=1 (keep finished renders), PYTHON (default /usr/bin/python3,
 # with python3-matplotlib for bench/strip.py). Every render runs under `nice -n 10`, 256x256.
 set -euf   # -f: no globbing, the [W,H] in --set values stay literal
@@ -14,8 +15,8 @@ MURK=${MURK:-./build/core/murk}
 PYTHON=${PYTHON:-/usr/bin/python3}
 T=${T:-15}
 REF_T=${REF_T:-60}
-OUT=out/glass
-DOC=docs/glass
+OUT=${OUT:-out/glass}
+DOC=${DOCS:-docs}/glass
 mkdir -p "$OUT" "$DOC"
 TABLE=$OUT/results.txt
 printf 'image\tspp\tseconds\trelMSE\n' > "$TABLE"
@@ -43,7 +44,7 @@ for scene in juice cloud; do
   : > "$list"
   for tr in delta spectral spectral_mis; do
     render "${scene}_$tr" "scenes/glass_$scene.yaml" --time "$T" --spp 100000 --set "media.$medium.type=$tr"
-    r=$("$MURK" compare "$OUT/${scene}_$tr.exr" "$OUT/${scene}_ref.exr" | awk '{print $4}')
+    r=$("$MURK" compare "$OUT/${scene}_$tr.exr" "$OUT/${scene}_ref.exr" | awk '/^MSE/ {print $4}')
     set -- $(cat "$OUT/${scene}_$tr.stats")
     printf '%s\t%s\t%s\t%s\n' "${scene}_$tr" "$1" "$2" "$r" >> "$TABLE"
     printf '%s\n' "$OUT/${scene}_$tr.png:$tr\\n$1 spp, $2 s\\nrelMSE $r" >> "$list"

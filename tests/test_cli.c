@@ -162,6 +162,43 @@ static void test_info(void **state)
     free(err);
 }
 
+/* `murk info IMAGE.png` prints the text keys of a preview murk wrote: murk:commit is the commit
+ * `murk --version` names; the EXR beside it carries the same. */
+static void test_info_image(void **state)
+{
+    (void)state;
+    const char *scene = write_tmp("img.yaml", "murk: 1\n"
+                                              "render: { resolution: [4, 4], spp: 1 }\n"
+                                              "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 30 }\n");
+    char *out = NULL, *err = NULL, exr[1024], png[1024], want[256];
+    snprintf(exr, sizeof exr, "%s", tmp_path("img.exr"));
+    snprintf(png, sizeof png, "%s", tmp_path("img.png"));
+    const char *const r[] = {"render", scene, "-o", exr, "--quiet", NULL};
+    assert_int_equal(run_murk_split(&out, &err, r), 0);
+    free(out);
+    free(err);
+    const char *const v[] = {"--version", NULL};
+    assert_int_equal(run_murk_split(&out, &err, v), 0);
+    const char *c = strstr(out, "(commit ");
+    assert_non_null(c);
+    snprintf(want, sizeof want, "murk:commit: %.*s\n", (int)strcspn(c + 8, ","), c + 8);
+    free(out);
+    free(err);
+    for (int k = 0; k < 2; k++) {
+        const char *const a[] = {"info", k ? exr : png, NULL};
+        assert_int_equal(run_murk_split(&out, &err, a), 0);
+        assert_contains(out, ": 4x4\n");
+        assert_contains(out, want);
+        assert_contains(out, "murk:version: ");
+        free(out);
+        free(err);
+    }
+    const char *const bad[] = {"info", png, "--set", "render.spp=2", NULL};
+    assert_int_equal(run_murk_split(&out, &err, bad), 2);
+    free(out);
+    free(err);
+}
+
 /* A process confined to one CPU (as mpirun's default binding confines a rank) and asked for 2 threads
  * says so; without --threads it takes 1, the CPUs it may run on. taskset is util-linux's. */
 static void test_affinity(void **state)
@@ -280,6 +317,7 @@ int main(void)
         cmocka_unit_test(test_help_everywhere),
         cmocka_unit_test(test_unknown_options),
         cmocka_unit_test(test_info),
+        cmocka_unit_test(test_info_image),
         cmocka_unit_test(test_affinity),
         cmocka_unit_test(test_outputs_checked_first),
     };

@@ -8,6 +8,7 @@
 #include "testutil.h"
 
 #include "image/image.h"
+#include "util/util.h"
 #include "murk/math.h"
 
 #include <dirent.h>
@@ -584,7 +585,7 @@ static void test_png_roundtrip(void **state)
     assert_int_equal(murk_png_read(path, 0, &raw, err, sizeof err), 0);
     assert_int_equal(img.w, W);
     assert_int_equal(img.h, H);
-    assert_int_equal(img.nmeta, 0);
+    assert_int_equal(img.nmeta, 2); /* murk:version, murk:commit */
     for (int i = 0; i < 3 * W * H; i++) {
         double want = isnan(rgb[i]) ? 0.0 : rgb[i] < 0 ? 0.0 : rgb[i] > 1 ? 1.0 : rgb[i];
         double enc = srgb_oetf(want);
@@ -615,6 +616,31 @@ static void test_png_exposure(void **state)
     assert_int_equal(murk_png_read(path, 1, &img, err, sizeof err), 0);
     for (int i = 0; i < 6; i++)
         assert_true(fabs(srgb_oetf(img.rgb[i]) - srgb_oetf(px[i] / 4.0)) <= 0.5 / 255 + 1e-5);
+    murk_image_free(&img);
+}
+
+/* Every PNG murk writes says which build wrote it: the text keys murk:commit and murk:version read back
+ * as the image's metadata; a PNG without them (a fixture written by libpng directly) has none. */
+static void test_png_commit_key(void **state)
+{
+    (void)state;
+    const float px[3] = {0.5f, 0.25f, 1.0f};
+    const char *path = tmp_file("commit.png");
+    murk_image img;
+    assert_int_equal(murk_png_write(path, px, 1, 1, 0.0f, err, sizeof err), 0);
+    assert_int_equal(murk_png_read(path, 1, &img, err, sizeof err), 0);
+    assert_non_null(murk_image_meta(&img, "murk:commit"));
+    assert_string_equal(murk_image_meta(&img, "murk:commit"), murk_build_commit());
+    assert_true(strlen(murk_build_commit()) >= 7);
+    assert_string_equal(murk_image_meta(&img, "murk:version"), murk_build_version());
+    murk_image_free(&img);
+
+    static const unsigned char grey[1] = {128};
+    png_fixture fx = {1, 1, 8, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, grey, NULL, 0, NULL, 0};
+    write_png_fixture(path, &fx);
+    assert_int_equal(murk_png_read(path, 1, &img, err, sizeof err), 0);
+    assert_null(murk_image_meta(&img, "murk:commit"));
+    assert_int_equal(img.nmeta, 0);
     murk_image_free(&img);
 }
 
@@ -862,6 +888,7 @@ int main(void)
         cmocka_unit_test(test_png_interlaced),
         cmocka_unit_test(test_png_broken_files),
         cmocka_unit_test(test_png_write_failures),
+        cmocka_unit_test(test_png_commit_key),
         cmocka_unit_test(test_exr_zip_equal_size_chunk),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -210,6 +210,57 @@ static void set_sigma(config *cfg, int chroma)
 }
 
 
+/* Channel c of src (channel from_c) into dst, which must hold as many samples. */
+static void take_channel(mt_acc *dst, const mt_acc *src, int c, int from_c)
+{
+    dst->n = src->n;
+    dst->k[c] = src->k[from_c];
+    dst->s[c] = src->s[from_c];
+    dst->s2[c] = src->s2[from_c];
+}
+
+/* The report's three-pass naive baseline: naive_spectral with `channel: red`, `green`, `blue`, each pass
+ * crediting its channel alone with weight 1 (and the others exactly 0); channel c taken from pass c must
+ * meet the closed forms (pass-through, collisions). Must fail: the passes put together one channel off
+ * (channel c from pass c+1's channel c+1, a chromatic medium) is refused. */
+static void test_naive_three_passes(void **state)
+{
+    (void)state;
+    nfail = 0;
+    static const mt_spec passes[3] = {{"pass_red", "type: naive_spectral, channel: red", 0},
+                                      {"pass_green", "type: naive_spectral, channel: green", 0},
+                                      {"pass_blue", "type: naive_spectral, channel: blue", 0}};
+    char common[256];
+    snprintf(common, sizeof common, "density: { constant: 0.5 }, %s", mt_sigma_keys(1));
+    murk_scene *s = mt_load_media("three_pass.yaml", common, "", passes, 3);
+    murk_ray ray = {murk_v3(0.1f, -0.2f, 0.3f), murk_normalize(murk_v3(1, 2, -2)), 0.0f, 1.5f};
+    double T[3], S[3];
+    for (int c = 0; c < 3; c++) {
+        double st = mt_sigma_t[1][c];
+        T[c] = exp(-st * 0.75);
+        S[c] = mt_sigma_s[1][c] / st * (1.0 - T[c]);
+    }
+    stats st[3];
+    mt_acc pass = {0}, scat = {0}, pass_off = {0}, scat_off = {0};
+    for (int c = 0; c < 3; c++) {
+        run_tracker(&s->media[c].m, &ray, n_main(), 3000 + (uint64_t)c, &st[c]);
+        for (int o = 0; o < 3; o++) /* a pass estimates its own channel only */
+            assert_true(o == c || (st[c].pass.k[o] == 0 && st[c].pass.s[o] == 0 && st[c].scat.s[o] == 0));
+    }
+    for (int c = 0; c < 3; c++) {
+        take_channel(&pass, &st[c].pass, c, c);
+        take_channel(&scat, &st[c].scat, c, c);
+        take_channel(&pass_off, &st[(c + 1) % 3].pass, c, (c + 1) % 3);
+        take_channel(&scat_off, &st[(c + 1) % 3].scat, c, (c + 1) % 3);
+    }
+    check3("three passes", "pass", &pass, T, 1);
+    check3("three passes", "scatter", &scat, S, 1);
+    assert_int_equal(nfail, 0);
+    double z = fmax(mt_zmax(&pass_off, T, 1e-5), mt_zmax(&scat_off, S, 1e-5));
+    assert_true(stat_must_fail("three passes put together one channel off", z > STAT_Z, z));
+    murk_scene_free(s);
+}
+
 /* ---- 1a/1b: transmittance and collisions, every tracker --------------------------------------- */
 
 /* Constant density 0.5 (infinite extent) over a segment of length 1.5: D = 0.75. */
@@ -575,6 +626,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(long_plateau),
         cmocka_unit_test(long_decomposition_control),
         cmocka_unit_test(long_majorant_half),
+        cmocka_unit_test(test_naive_three_passes),
     };
     return STAT_RUN(tests, argc, argv);
 }

@@ -89,10 +89,14 @@ def write_atomic(path, write):
         raise
 
 
-def save(fig, d, name):
+def save(fig, d, name, meta=None):
+    """PNG and SVG; the PNG carries murk's text keys murk:commit and murk:version (from bench.json)."""
     for ext in ("png", "svg"):
+        md = None
+        if ext == "png" and meta:
+            md = {"murk:commit": str(meta.get("commit", "unknown")), "murk:version": str(meta.get("version", "unknown"))}
         write_atomic(os.path.join(d, name + "." + ext),
-                     lambda tmp: fig.savefig(tmp, format=ext, dpi=110, bbox_inches="tight"))
+                     lambda tmp: fig.savefig(tmp, format=ext, dpi=110, bbox_inches="tight", metadata=md))
     plt.close(fig)
 
 
@@ -126,7 +130,7 @@ def error_chart(d, meta, agg, cost, xlabel, name):
     ax.grid(True, which="both", alpha=0.3)
     if not empty:
         ax.legend(fontsize=8)
-    save(fig, d, name)
+    save(fig, d, name, meta)
 
 
 def efficiency_chart(d, meta, agg):
@@ -157,7 +161,7 @@ def efficiency_chart(d, meta, agg):
         ax.set_ylabel("efficiency relative to '%s'" % meta["variants"][0])
         ax.set_title(title, fontsize=10)
         ax.legend(fontsize=8)
-    save(fig, d, "efficiency")
+    save(fig, d, "efficiency", meta)
 
 
 def box_blur(a, r):
@@ -198,7 +202,7 @@ def efficiency_map(d, meta, agg):
         if flat.any():
             handles.append(Patch(color=(0.5, 0.5, 0.5), label="no error in any variant (%.0f%%)" % (100 * flat.mean())))
         ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.02), ncol=2)
-    save(fig, d, "efficiency_map")
+    save(fig, d, "efficiency_map", meta)
     return shares
 
 
@@ -220,6 +224,23 @@ def fmt(x, s):
     if not (x == x):
         return "n/a"
     return "%.3g ± %.2g" % (x, s) if s == s else "%.3g" % x
+
+
+# A ratio of efficiencies is a measured difference only when it lies more than this many standard errors
+# from 1; closer, the summary says that no variant is measurably better.
+RESOLVED_SE = 2.0
+
+
+def load_line(meta):
+    """The load average before and after the renders (bench.json), and whether it exceeded the cores."""
+    ld = meta.get("load")
+    if not ld or ld["before"][0] < 0:
+        return "load average: not recorded"
+    worst = max(ld["before"][0], ld["after"][0])
+    return "load average (1, 5, 15 min): %s before the renders, %s after%s" % (
+        ", ".join("%.2f" % x for x in ld["before"]), ", ".join("%.2f" % x for x in ld["after"]),
+        "; **above the %d cores: times, and equal-time ratios, are noisy (lookups are not)**" % meta["cores"]
+        if worst > meta["cores"] else "")
 
 
 def summary(meta, agg, shares):
@@ -245,14 +266,30 @@ def summary(meta, agg, shares):
             parts.append("%s its efficiency is %s." % (what, fmt(e, se)))
         elif best[2] == 0:
             runner = max((x for x in ok if x[2]), key=lambda x: x[0], default=None)
-            parts.append("%s '%s' (the first variant) is the most efficient; the next best, '%s', reaches %s of "
-                         "its efficiency." % (what, base, meta["variants"][runner[2]],
-                                               fmt(runner[0], runner[1])) if runner else "")
+            sig = (1 - runner[0]) / runner[1] if runner and runner[1] > 0 else float("inf")
+            if runner and sig < RESOLVED_SE:
+                parts.append("%s no variant is measurably more efficient than another: the next best after '%s', "
+                             "'%s', reaches %s of its efficiency (%.1f standard errors below 1; a difference needs "
+                             "%g)." % (what, base, meta["variants"][runner[2]], fmt(runner[0], runner[1]), sig,
+                                       RESOLVED_SE))
+            else:
+                parts.append("%s '%s' (the first variant) is the most efficient; the next best, '%s', reaches %s of "
+                             "its efficiency." % (what, base, meta["variants"][runner[2]],
+                                                   fmt(runner[0], runner[1])) if runner else "")
         else:
             sig = (best[0] - 1) / best[1] if best[1] > 0 else float("inf")
-            parts.append("%s '%s' is the most efficient: %s× the efficiency of '%s' (%s)." %
-                         (what, meta["variants"][best[2]], fmt(best[0], best[1]), base,
-                          "%.1f standard errors above 1" % sig if sig == sig else "no error estimate"))
+            if not best[1] > 0:
+                parts.append("%s '%s' has the largest efficiency, %s× that of '%s', but with one seed there is no "
+                             "error estimate: no difference is resolved." %
+                             (what, meta["variants"][best[2]], fmt(best[0], best[1]), base))
+            elif sig < RESOLVED_SE:
+                parts.append("%s no variant is measurably more efficient than '%s': the best, '%s', reaches %s× its "
+                             "efficiency (%.1f standard errors above 1; a difference needs %g)." %
+                             (what, base, meta["variants"][best[2]], fmt(best[0], best[1]), sig, RESOLVED_SE))
+            else:
+                parts.append("%s '%s' is the most efficient: %s× the efficiency of '%s' (%s)." %
+                             (what, meta["variants"][best[2]], fmt(best[0], best[1]), base,
+                              "%.1f standard errors above 1" % sig if best[1] > 0 else "no error estimate"))
     parts = parts[:1] + [p[:1].upper() + p[1:] for p in parts[1:]]
     ref = meta["reference"]
     if ref["noise_estimated"]:
@@ -280,6 +317,7 @@ def report(d, meta, agg, shares):
          "```sh", meta["command"], "```", "",
          "- murk %s; machine: %s; render threads: %s" % (meta["version"], machine(meta),
                                                          meta["threads"] or "all cores"),
+         "- " + load_line(meta),
          "- budgets: %s per render, each with %d seeds; variants: %d" % ("seconds (equal time)" if unit == "s" else "spp",
                                                                        meta["repeat"], len(meta["variants"])),
          "- reference: `%s` (%s)" % (meta["reference"]["path"], "given" if meta["reference"]["given"] else

@@ -1,9 +1,17 @@
 """docs/stability.md and its heat maps from the atlas rows (bench/stability/atlas.py)."""
-import math, os
+import math, os, sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tools"))
+import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
 
 import numpy as np
 
 FIG_DIR = "stability"  # under docs/
+
+
+def docs_dir(root):
+    """docs/ of the tree, or MURK_DOCS_DIR when set (tools/docs.sh writes a whole docs folder elsewhere)."""
+    return os.environ.get("MURK_DOCS_DIR") or os.path.join(root, "docs")
 
 
 def fmt(x, spec="%.3g"):
@@ -45,8 +53,8 @@ def heatmaps(root, rows, sweep, title):
                else float("nan"), "RdYlGn", (-2, 2)),
               ("firefly rate (samples > 100x pixel mean)", lambda r: r["firefly"], "magma_r", (0, None)),
               ("|bias z| (image mean)", lambda r: abs(r["z"]), "Reds", (0, 5))]
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels) + 1.5, 0.32 * len(labels) + 1.8))
-    for ax, (name, f, cmap, (lo, hi)) in zip(axes, panels):
+    mats = []
+    for name, f, cmap, lim in panels:
         M = np.full((len(labels), len(vals)), np.nan)
         for i, (m, t) in enumerate([(m, t) for m in media for t in meths]):
             for j, v in enumerate(vals):
@@ -54,23 +62,28 @@ def heatmaps(root, rows, sweep, title):
                       r["value"] == v]
                 if rr:
                     M[i, j] = f(rr[0])
+        if np.isfinite(M).any():  # a panel with no number (no delta to compare with) is left out, not drawn empty
+            mats.append((name, M, cmap, lim))
+    fig, axes = plt.subplots(1, len(mats), figsize=(4.8 * len(mats) + 2.5, 0.42 * len(labels) + 2.2), squeeze=False)
+    axes = axes[0]
+    for ax, (name, M, cmap, (lo, hi)) in zip(axes, mats):
         top = hi if hi is not None else max(1e-3, np.nanmax(M) if np.isfinite(M).any() else 1)
         im = ax.imshow(M, cmap=cmap, vmin=lo, vmax=top, aspect="auto")
         for i in range(M.shape[0]):
             for j in range(M.shape[1]):
                 if np.isfinite(M[i, j]):
-                    ax.text(j, i, "%.2g" % M[i, j], ha="center", va="center", fontsize=6)
+                    ax.text(j, i, "%.2g" % M[i, j], ha="center", va="center", fontsize=9)
         ax.set_xticks(range(len(vals)))
-        ax.set_xticklabels([str(v) for v in vals], fontsize=7)
+        ax.set_xticklabels([str(v) for v in vals], fontsize=10)
         ax.set_yticks(range(len(labels)))
-        ax.set_yticklabels(labels if ax is axes[0] else [""] * len(labels), fontsize=7)
-        ax.set_title(name, fontsize=8)
-        fig.colorbar(im, ax=ax, fraction=0.04)
-    fig.suptitle("%s — %s" % (sweep, title), fontsize=9)
+        ax.set_yticklabels(labels if ax is axes[0] else [""] * len(labels), fontsize=10)
+        ax.set_title(name, fontsize=11)
+        fig.colorbar(im, ax=ax, fraction=0.04).ax.tick_params(labelsize=9)
+    fig.suptitle("%s — %s" % (sweep, title), fontsize=12)
     fig.tight_layout()
-    os.makedirs(os.path.join(root, "docs", FIG_DIR), exist_ok=True)
+    os.makedirs(os.path.join(docs_dir(root), FIG_DIR), exist_ok=True)
     rel = "%s/%s.png" % (FIG_DIR, sweep)
-    fig.savefig(os.path.join(root, "docs", rel), dpi=80)
+    fig.savefig(os.path.join(docs_dir(root), rel), dpi=90, metadata=pngmeta.metadata())
     plt.close(fig)
     return rel
 
@@ -360,6 +373,6 @@ def write(root, meta, rows, sweep_doc, prose=None):
                 fmt(r["relvar"], "%.2e"), fmt(r["seconds"], "%.2f"), r.get("lookups", "—"), fmt(r["eff_rel"], "%.2f"),
                 fmt(r.get("eff_lookups_rel", float("nan")), "%.2f"), r["z"], r["zblock"]))
         L.append("")
-    with open(os.path.join(root, "docs", "stability.md"), "w") as f:
+    with open(os.path.join(docs_dir(root), "stability.md"), "w") as f:
         f.write("\n".join(L))
     print("wrote docs/stability.md and docs/%s/*.png" % FIG_DIR)

@@ -54,10 +54,12 @@ static const struct command_help {
      "Errors are one line, FILE:LINE:COL: what is wrong (or --set KEY.PATH=VALUE: what is wrong), exit 1.\n"},
     {"info",
      "usage: murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
+     "       murk info IMAGE.png | IMAGE.exr\n"
      "Loads SCENE.yaml (with the overrides, checked as murk render checks them) and lists the render settings,\n"
      "the camera, the integrator, each medium (tracker, transmittance estimator, density grid, majorant grid),\n"
      "the materials, the shapes (with their material, interior and exterior) and the plugins each uses with the\n"
-     "file each was loaded from. Renders nothing.\n"},
+     "file each was loaded from. Renders nothing. Given an image (a name ending in .png or .exr), prints its size\n"
+     "and its text keys, one 'KEY: VALUE' a line: murk:commit and murk:version say which build wrote it.\n"},
     {"plugins",
      "usage: murk plugins [--markdown] [--all | NAME]\n"
      "Without NAME: lists every plugin on the search path ($MURK_PLUGIN_PATH, then the build's or the installed\n"
@@ -492,7 +494,7 @@ static int write_image(const render_args *ra, const murk_scene *s, const murk_re
     snprintf(ntiles, sizeof ntiles, "%d", murk_part_tiles(res->width, res->height, o->part, o->parts));
     murk_kv meta[] = {
         {"murk:scene", ra->scene}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
-        {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
+        {"murk:version", MURK_VERSION}, {"murk:commit", murk_build_commit()}, {"murk:integrator", s->integrator_plugin->desc->name},
         {"murk:nonfinite_samples", nonfinite}, {"murk:set", ra->setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
         {"murk:resumed_from", o->resume ? o->resume : ""}, {"murk:counters", counters},
@@ -702,7 +704,8 @@ int murk_cli_main(int argc, char **argv)
         return usage(NULL);
     const char *cmd = argv[1];
     if (!strcmp(cmd, "--version")) {
-        printf("murk %s (plugin ABI %d.%d)\n", MURK_VERSION, MURK_ABI_MAJOR, MURK_ABI_MINOR);
+        printf("murk %s (commit %s, plugin ABI %d.%d)\n", MURK_VERSION, murk_build_commit(), MURK_ABI_MAJOR,
+               MURK_ABI_MINOR);
         return 0;
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {

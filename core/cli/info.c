@@ -1,8 +1,10 @@
 /* info.c — `murk info SCENE.yaml [--set KEY.PATH=VALUE ...]`: loads a scene as `murk render` does (same
  * checks, same messages) and lists what it holds: render settings, camera, integrator, media (tracker,
  * transmittance estimator, density, majorant grid), materials, shapes (material, interior, exterior) and
- * every plugin loaded, with its file. Renders nothing. Part of the murk executable, not of libmurk. */
+ * every plugin loaded, with its file. Renders nothing. Given an image instead (IMAGE.png, IMAGE.exr): its
+ * size and text keys, murk:commit among them. Part of the murk executable, not of libmurk. */
 #include "cli/cli.h"
+#include "image/image.h"
 #include "load/load.h"
 #include "media/density.h"
 #include "media/media.h"
@@ -13,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 /* A scene node inline, as YAML flow ("[0.5, 0.5, 0.5]", "{ seed: 7, coverage: 0.7 }"), made printable;
  * keys in skip[] are left out of a map. */
@@ -178,6 +181,32 @@ murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nset
     return s;
 }
 
+/* 1 if path names an image murk info reads instead of a scene (by its extension, any case). */
+static int image_path(const char *path)
+{
+    size_t n = strlen(path);
+    return n > 4 && (!strcasecmp(path + n - 4, ".png") || !strcasecmp(path + n - 4, ".exr"));
+}
+
+/* `murk info IMAGE`: its size and its text keys (PNG tEXt/zTXt/iTXt, EXR string attributes), one a line. */
+static int info_image(const char *path)
+{
+    murk_image img;
+    char err[1024], k[256], v[4096];
+    size_t n = strlen(path);
+    int rc = !strcasecmp(path + n - 4, ".png") ? murk_png_read(path, 1, &img, err, sizeof err)
+                                                : murk_exr_read(path, &img, err, sizeof err);
+    if (rc != 0) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    printf("%s: %dx%d\n", murk_printable(v, sizeof v, path), img.w, img.h);
+    for (int i = 0; i < img.nmeta; i++)
+        printf("%s: %s\n", murk_printable(k, sizeof k, img.meta[i].key), murk_printable(v, sizeof v, img.meta[i].value));
+    murk_image_free(&img);
+    return 0;
+}
+
 int murk_cli_info(int argc, char **argv)
 {
     const char *scene_path = NULL;
@@ -208,6 +237,14 @@ int murk_cli_info(int argc, char **argv)
                     murk_printable(buf, sizeof buf, scene_path), murk_printable(buf2, sizeof buf2, a));
             return 2;
         }
+    }
+    if (scene_path && image_path(scene_path)) {
+        free(sets);
+        if (nsets) {
+            fprintf(stderr, "murk: --set applies to a scene, not to the image '%s'\n", murk_printable(buf, sizeof buf, scene_path));
+            return 2;
+        }
+        return info_image(scene_path);
     }
     if (!scene_path) {
         free(sets);

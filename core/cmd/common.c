@@ -17,6 +17,7 @@ const char murk_cli_usage_text[] =
     "  mpirun -n N murk render ...          (one image over N processes)\n"
     "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
     "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
+    "  murk info IMAGE.png|IMAGE.exr        (its text keys: murk:commit, murk:version)\n"
     "  murk plugins [--markdown] [--all | NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]] [--html PAGE.html]\n"
     "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"

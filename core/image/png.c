@@ -4,7 +4,9 @@
  * (atomic.h) renames over PATH only when all of it was written. The reader lets libpng reduce every
  * 8/16-bit grey, grey+alpha, RGB, RGBA or palette image to 8-bit RGB, then maps it to linear floats
  * (the exact sRGB EOTF, or v/255). libpng errors longjmp back into small functions whose caller owns
- * every resource, so nothing leaks. */
+ * every resource, so nothing leaks. Every PNG written carries the text keys murk:version and murk:commit
+ * (the build's, util/commit.c), so a figure says which build made it; the reader returns a file's text
+ * keys (tEXt, zTXt, iTXt, before or after the image data) as the image's metadata. */
 #include "image/image.h"
 #include "util/atomic.h"
 #include "util/error.h"
@@ -29,6 +31,7 @@ typedef struct png_job {
     char msg[200];
     const char *path;   /* read: for the size check's message */
     uint64_t file_size; /* read: the file's size */
+    murk_image *img;    /* read: receives the text keys as metadata */
 } png_job;
 
 static void png_error_cb(png_structp png, png_const_charp msg)
@@ -65,6 +68,14 @@ static int png_encode(png_job *j, const float *rgb, int w, int h, double scale)
     png_set_IHDR(j->png, j->info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(j->png, j->info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_text text[2];
+    memset(text, 0, sizeof text);
+    text[0].compression = text[1].compression = PNG_TEXT_COMPRESSION_NONE;
+    text[0].key = (png_charp) "murk:version";
+    text[0].text = (png_charp)murk_build_version();
+    text[1].key = (png_charp) "murk:commit";
+    text[1].text = (png_charp)murk_build_commit();
+    png_set_text(j->png, j->info, text, 2);
     png_write_info(j->png, j->info);
     for (int y = 0; y < h; y++) {
         const float *src = rgb + (size_t)y * (size_t)w * 3;
@@ -115,6 +126,30 @@ MURK_API int murk_png_write(const char *path, const float *rgb, int w, int h, fl
     return murk_write_atomic(path, png_fill, &o, err, errlen);
 }
 
+/* The file's text chunks into j->img's metadata (pairs malloc'd; murk_image_free releases them). */
+static int png_copy_text(png_job *j)
+{
+    png_textp text = NULL;
+    int n = png_get_text(j->png, j->info, &text, NULL);
+    if (n <= 0 || !text)
+        return 0;
+    j->img->meta = calloc((size_t)n, sizeof *j->img->meta);
+    if (!j->img->meta) {
+        snprintf(j->msg, sizeof j->msg, "out of memory");
+        return -1;
+    }
+    for (int i = 0; i < n; i++) {
+        murk_kv *kv = &j->img->meta[j->img->nmeta++]; /* counted first: murk_image_free releases a half pair */
+        kv->key = strdup(text[i].key ? text[i].key : "");
+        kv->value = strdup(text[i].text ? text[i].text : "");
+        if (!kv->key || !kv->value) {
+            snprintf(j->msg, sizeof j->msg, "out of memory");
+            return -1;
+        }
+    }
+    return 0;
+}
+
 /* The libpng calls of a read into j->pix (allocated here, freed by the caller). */
 static int png_decode(png_job *j)
 {
@@ -163,11 +198,11 @@ static int png_decode(png_job *j)
     for (size_t y = 0; y < j->h; y++)
         j->rows[y] = j->pix + y * (size_t)j->w * 3;
     png_read_image(j->png, j->rows);
-    png_read_end(j->png, NULL);
-    return 0;
+    png_read_end(j->png, j->info); /* text chunks after the image data land in info too */
+    return png_copy_text(j);
 }
 
-int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
+MURK_API int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
 {
     png_job j;
     memset(&j, 0, sizeof j);
@@ -175,6 +210,7 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
     if (fd < 0)
         return -1;
     j.path = path;
+    j.img = img;
     j.file_size = murk_image_fd_size(fd);
     j.fp = fdopen(fd, "rb");
     if (!j.fp) {
@@ -217,5 +253,7 @@ int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t
         }
     }
     free(j.pix);
+    if (rc != 0)
+        murk_image_free(img); /* the text keys read before the failure */
     return rc;
 }

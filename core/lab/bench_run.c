@@ -154,6 +154,7 @@ typedef struct meta_job {
     const reference *r;
     int argc;
     char **argv;
+    const double *load; /* the 1-, 5- and 15-minute load averages before the renders, then after; < 0: unknown */
 } meta_job;
 
 /* bench.json: what the chart script needs besides bench.csv. */
@@ -175,10 +176,13 @@ static int meta_fill(FILE *f, const char *tmp, void *user, char *err, size_t err
     }
     fprintf(f, "{\n  \"command\": ");
     json_str(f, cmd);
-    fprintf(f, ",\n  \"version\": \"%s\",\n  \"scene\": ", MURK_VERSION);
+    fprintf(f, ",\n  \"version\": \"%s\",\n  \"commit\": \"%s\",\n  \"scene\": ", MURK_VERSION, murk_build_commit());
     json_str(f, b->scene);
     fprintf(f, ",\n  \"budget\": \"%s\",\n  \"repeat\": %d,\n  \"threads\": %d,\n  \"cores\": %d,\n",
             b->time_mode ? "seconds" : "spp", b->repeat, b->threads, murk_cpus_usable());
+    if (j->load) /* the machine's load: times measured while other work ran are noisy */
+        fprintf(f, "  \"load\": {\"before\": [%.2f, %.2f, %.2f], \"after\": [%.2f, %.2f, %.2f]},\n", j->load[0],
+                j->load[1], j->load[2], j->load[3], j->load[4], j->load[5]);
     fprintf(f, "  \"reference\": {\"path\": ");
     json_str(f, b->reference ? b->reference : r->path);
     fprintf(f, ", \"given\": %s, \"reused\": %s, \"spp\": %d, \"seconds\": %.3f, \"noise_estimated\": %s, \"sets\": [",
@@ -303,7 +307,24 @@ typedef struct run {
     int big;              /* the largest budget's index */
     int done, total;      /* whole renders recorded, and asked for */
     double t0;
+    double load[6];       /* load averages (1, 5, 15 min) before the renders and after (note_load) */
 } run;
+
+/* Records the load average in load[0..2] and warns when its 1-minute figure exceeds the cores murk may
+ * run on: other processes then share the CPUs and every time measured is noisy (`when`: "before" or
+ * "after" the renders). */
+static void note_load(double load[3], const char *when)
+{
+    int cores = murk_cpus_usable();
+    if (getloadavg(load, 3) != 3) {
+        load[0] = load[1] = load[2] = -1.0;
+        return;
+    }
+    if (load[0] > cores)
+        fprintf(stderr, "murk bench: warning: load average %.2f %s the renders, above the %d cores murk may use: "
+                        "other work shares the CPUs, so times (and equal-time ratios) are noisy; lookups are not\n",
+                load[0], when, cores);
+}
 
 /* The reference: given (--reference), or rendered or taken from the cache (murk_bench_reference); said on
  * stdout. 0, 1 after a message, or the stop status when a signal came while rendering it. */
@@ -519,7 +540,7 @@ static int write_maps(run *u, int argc, char **argv)
         }
     }
     snprintf(path, sizeof path, "%s/bench.json", b->out);
-    meta_job mj = {b, &u->r, argc, argv};
+    meta_job mj = {b, &u->r, argc, argv, u->load};
     if (murk_write_atomic(path, meta_fill, &mj, err, sizeof err) != 0) {
         fprintf(stderr, "murk: %s\n", err);
         return 1;
@@ -547,7 +568,9 @@ int murk_bench_run(const bench *b, int argc, char **argv)
     fflush(stdout);
     rc = run_open(&u);
     if (u.csv) {
+        note_load(u.load, "before");
         rc = rc ? rc : sweep(&u);
+        note_load(u.load + 3, "after");
         rc = write_rows(&u, rc);
     }
     if (rc == 0)

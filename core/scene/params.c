@@ -166,6 +166,19 @@ static int read_value(murk_scene *s, const murk_param *p, murk_value *v, const m
     }
 }
 
+/* Parameter i (MURK_PARAM_ALT_SCALE) and the one before it are one parameter on two scales, and the map
+ * gives both: the error, located at whichever of the two keys comes second. */
+static int both_scales(const murk_plugin_desc *d, const murk_ynode *map, uint32_t i, const char *who, char *err,
+                       size_t errlen)
+{
+    size_t at = 0;
+    for (size_t k = 0; k < map->n; k++)
+        if (!strcmp(map->keys[k], d->params[i].name) || !strcmp(map->keys[k], d->params[i - 1].name))
+            at = k;
+    return murk_yerr_key(err, errlen, map, at, "%s: '%s' and '%s' are two scales of one parameter: give one", who,
+                         d->params[i - 1].name, d->params[i].name);
+}
+
 /* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
  * block in messages, e.g. "material 'metal' (ggx)". */
 int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
@@ -201,6 +214,9 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
         if (read_value(s, &d->params[idx], &values[idx], map->items[k], what, err, errlen))
             return -1;
     }
+    for (uint32_t i = 1; i < d->nparams; i++)
+        if ((d->params[i].flags & MURK_PARAM_ALT_SCALE) && values[i].set && values[i - 1].set)
+            return both_scales(d, map, i, who, err, errlen);
     for (uint32_t i = 0; i < d->nparams; i++)
         if ((d->params[i].flags & MURK_PARAM_REQUIRED) && !values[i].set)
             return murk_yerr(err, errlen, map, "%s is missing the required parameter '%s'", who, d->params[i].name);

@@ -25,5 +25,9 @@ int murk_cpus_usable(void); /* CPUs this process may run on (its affinity mask),
  * Writes at most n bytes including the NUL (cut short at a character boundary) and returns dst. The
  * error formatter, murk_log and the command line pass every echoed name, key and value through it. */
 MURK_API char *murk_printable(char *dst, size_t n, const char *src);
+/* The git commit murk was built from ("c7e151510217", "...-dirty" for uncommitted changes, "unknown"
+ * outside a checkout) and its version: every PNG and EXR murk writes carries both (commit.c). */
+MURK_API const char *murk_build_commit(void);
+MURK_API const char *murk_build_version(void);
 
 #endif

@@ -2,6 +2,7 @@
 """Regenerates docs/results/transmittance.csv and the transmittance_*.png charts of docs/results.md.
 
     /usr/bin/python3 docs/results/plot.py [BUILD_DIR] [SEGMENTS] [ESTIMATES]   (defaults: build 200 1000)
+    /usr/bin/python3 docs/results/plot.py --from-csv docs/results/transmittance.csv   (the charts only)
 
 Runs BUILD_DIR/bench/transmittance (see bench/transmittance.c), keeps its CSV, and draws per scene the
 error of the mean of n estimates, sqrt(bias^2 + var / n) averaged over the channels' MSE, against the
@@ -17,18 +18,36 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tools"))
+import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
+
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
-build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
-nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
-nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
-out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
-                     capture_output=True, text=True).stdout
-with open(os.path.join(here, "transmittance.csv"), "w") as f:
-    f.write(out)
+# MURK_DOCS_DIR (tools/docs.sh): write the CSV and charts into MURK_DOCS_DIR/results instead of docs/results
+if os.environ.get("MURK_DOCS_DIR"):
+    here = os.path.join(os.environ["MURK_DOCS_DIR"], "results")
+    os.makedirs(here, exist_ok=True)
+if len(sys.argv) > 2 and sys.argv[1] == "--from-csv":  # redraw the charts from a CSV measured before
+    with open(sys.argv[2]) as f:
+        out = f.read()
+    nseg, nest = "200", "1000"
+else:
+    build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
+    nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
+    nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
+    out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
+                         capture_output=True, text=True).stdout
+    with open(os.path.join(here, "transmittance.csv"), "w") as f:
+        f.write(out)
 rows = list(csv.DictReader(out.splitlines()))
-styles = {"ratio": ("k", "-"), "residual_ratio": ("tab:blue", "-"), "track_length": ("tab:gray", "-"),
-          "unbiased_raymarch": ("tab:green", "-"), "power_series": ("tab:purple", "-")}
+# one colour and one marker per estimator, never shared: tab10's ten colours, then tab20's darker half;
+# solid lines for the unbiased estimators, dashed for the biased raymarch baselines
+COLOURS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+           "tab:olive", "tab:cyan", "k", "navy", "darkgoldenrod", "teal"]
+MARKERS = ["o", "s", "^", "v", "D", "P", "X", "*", "<", ">", "h", "p", "d", "8"]
+names = list(dict.fromkeys(r["estimator"] for r in rows))
+styles = {nm: (COLOURS[i % len(COLOURS)], "--" if nm.startswith("raymarch") else "-", MARKERS[i % len(MARKERS)])
+          for i, nm in enumerate(names)}
 for scene in dict.fromkeys(r["scene"] for r in rows):
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
     for r in (r for r in rows if r["scene"] == scene):
@@ -40,20 +59,22 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
         L, ns = max(float(r["lookups"]), 1e-3), float(r["ns"])
         n = [2 ** (k / 4) for k in range(0, 4 * 20 + 1)]
         err = [(b2 + var / k) ** 0.5 for k in n]
-        color, ls = styles.get(name, (None, "--" if name.startswith("raymarch") else ":"))
+        color, ls, mk = styles[name]
         label = name + (" (BIASED)" if name.startswith("raymarch") else "")
-        axes[0].loglog([k * L for k in n], err, color=color, ls=ls, label=label)
-        axes[1].loglog([k * ns * 1e-3 for k in n], err, color=color, ls=ls, label=label)
-    axes[0].set_xlabel("density lookups spent on one segment")
-    axes[1].set_xlabel("time spent on one segment (us, one thread)")
+        kw = dict(color=color, ls=ls, marker=mk, markevery=8, markersize=6, lw=1.6, label=label)
+        axes[0].loglog([k * L for k in n], err, **kw)
+        axes[1].loglog([k * ns * 1e-3 for k in n], err, **kw)
+    axes[0].set_xlabel("density lookups spent on one segment", fontsize=11)
+    axes[1].set_xlabel("time spent on one segment (us, one thread)", fontsize=11)
     for ax in axes:
-        ax.set_ylabel("RMSE of the mean transmittance")
+        ax.tick_params(labelsize=10)
+        ax.set_ylabel("RMSE of the mean transmittance", fontsize=11)
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_xlim(1, 1e5)
     axes[1].set_xlim(0.1, 1e4)
-    axes[1].legend(fontsize=7, loc="lower left")
+    axes[1].legend(fontsize=9, loc="lower left")
     fig.suptitle(f"{scene}: shadow-ray transmittance, error vs cost (bench/transmittance, {nseg} segments x {nest})")
     fig.tight_layout()
-    fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90)
+    fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90, metadata=pngmeta.metadata())
     plt.close(fig)
 print(out, end="")

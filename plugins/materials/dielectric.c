@@ -8,15 +8,20 @@
 #include "murk/material.h"
 #include "murk/microfacet.h"
 
+#include <stdio.h>
 #include <string.h>
 
-enum { P_IOR, P_ROUGHNESS, P_TINT, P_MULTISCATTER, P_COUNT };
+enum { P_IOR, P_ROUGHNESS, P_ALPHA, P_TINT, P_MULTISCATTER, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_IOR] = {"ior", MURK_PARAM_RGB, 0, {1.5, 1.5, 1.5}, NULL, NULL, 1.0, 4.0,
                "index of refraction inside relative to outside; three values: RGB dispersion"},
     [P_ROUGHNESS] = {"roughness", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
-                     "0: smooth (delta lobes); > 0: GGX with alpha = roughness^2 (>= 0.001)"},
+                     "0: smooth (delta lobes); > 0: GGX with alpha = roughness^2 (>= 0.001), murk's convention; "
+                     "give this or alpha, not both"},
+    [P_ALPHA] = {"alpha", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE | MURK_PARAM_ALT_SCALE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
+                 "GGX alpha given directly (the reference report's convention), the same as roughness "
+                 "sqrt(alpha); 0: smooth; give this or roughness, not both"},
     [P_TINT] = {"tint", MURK_PARAM_RGB, MURK_PARAM_TEXTURABLE, {1.0, 1.0, 1.0}, NULL, NULL, 0.0, 1.0,
                 "multiplies transmitted light at each crossing"},
     [P_MULTISCATTER] = {"multiscatter", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
@@ -43,6 +48,7 @@ typedef struct dielectric {
     const murk_host *host;
     murk_value p[P_COUNT];
     float eta[3];
+    int use_alpha;  /* alpha was given (else roughness, alpha = roughness^2) */
     int dispersive; /* the channels' indices differ */
     int ms;         /* multiple-scattering compensation */
     di_ms tab[3];   /* per channel (only [0] when not dispersive) */
@@ -59,9 +65,16 @@ static void shade_at(const dielectric *d, const murk_hit *hit, di_shade *sh)
 {
     float v[3];
     sh->inside = murk_material_wo_inside(hit);
-    murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
-    float r = murk_clamp01(v[0]);
-    sh->alpha = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
+    float a;
+    if (d->use_alpha) {
+        murk_value_eval(d->host, &d->p[P_ALPHA], hit, v);
+        a = murk_clamp01(v[0]);
+    } else {
+        murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
+        float r = murk_clamp01(v[0]);
+        a = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
+    }
+    sh->alpha = a > 0.0f ? murk_maxf(a, DI_ALPHA_MIN) : 0.0f;
     murk_value_eval(d->host, &d->p[P_TINT], hit, v);
     sh->tint = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
 }
@@ -266,8 +279,10 @@ static void ms_build(di_ms *t, double eta)
 /* ---- Plugin interface ---------------------------------------------------------------------- */
 static int di_create(const murk_host *host, const murk_value *p, void **self, char *err, size_t errlen)
 {
-    (void)err;
-    (void)errlen;
+    if (p[P_ALPHA].set && p[P_ROUGHNESS].set) { /* the loader refuses it first (MURK_PARAM_ALT_SCALE) */
+        snprintf(err, errlen, "'roughness' and 'alpha' are two scales of one parameter: give one");
+        return -1;
+    }
     dielectric *d = host->alloc(sizeof *d);
     if (!d)
         return -1;
@@ -275,6 +290,7 @@ static int di_create(const murk_host *host, const murk_value *p, void **self, ch
     memcpy(d->p, p, sizeof d->p);
     for (int c = 0; c < 3; c++)
         d->eta[c] = (float)p[P_IOR].f[c];
+    d->use_alpha = p[P_ALPHA].set != 0;
     d->dispersive = d->eta[0] != d->eta[1] || d->eta[1] != d->eta[2];
     d->ms = p[P_MULTISCATTER].f[0] != 0.0;
     for (int c = 0; d->ms && c < (d->dispersive ? 3 : 1); c++)

@@ -7,6 +7,7 @@
 #include "murk/material.h"
 #include "murk/microfacet.h"
 
+#include <stdio.h>
 #include <string.h>
 
 enum { P_ALBEDO, P_SPECULAR, P_ROUGHNESS, P_ALPHA, P_MULTISCATTER, P_COUNT };
@@ -17,9 +18,12 @@ static const murk_param params[P_COUNT] = {
     [P_SPECULAR] = {"specular", MURK_PARAM_RGB, MURK_PARAM_TEXTURABLE, {0.04, 0.04, 0.04}, NULL, NULL, 0.0, 1.0,
                     "normal-incidence reflectance F0 of the coat (Schlick Fresnel)"},
     [P_ROUGHNESS] = {"roughness", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE, {0.5, 0, 0}, NULL, NULL, 0.0, 1.0,
-                     "perceptual roughness; GGX alpha = roughness^2 (clamped to >= 0.001)"},
-    [P_ALPHA] = {"alpha", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
-                 "GGX alpha directly; if given it overrides roughness (clamped to >= 0.001)"},
+                     "perceptual roughness, murk's convention: GGX alpha = roughness^2 (clamped to >= 0.001); "
+                     "give this or alpha, not both"},
+    [P_ALPHA] = {"alpha", MURK_PARAM_FLOAT, MURK_PARAM_TEXTURABLE | MURK_PARAM_ALT_SCALE, {0.0, 0, 0}, NULL, NULL, 0.0, 1.0,
+                 "GGX alpha given directly (the reference report's convention: its D(h) takes alpha, not its "
+                 "square root), the same as roughness sqrt(alpha) (clamped to >= 0.001); give this or roughness, "
+                 "not both"},
     [P_MULTISCATTER] = {"multiscatter", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
                         "multiple-scattering compensation of the coat (Kulla & Conty 2017); false: single scattering"},
 };
@@ -251,8 +255,10 @@ static float ggx_pdf_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
 /* ---- Plugin interface ---------------------------------------------------------------------- */
 static int ggx_create(const murk_host *host, const murk_value *p, void **self, char *err, size_t errlen)
 {
-    (void)err;
-    (void)errlen;
+    if (p[P_ALPHA].set && p[P_ROUGHNESS].set) { /* the loader refuses it first (MURK_PARAM_ALT_SCALE) */
+        snprintf(err, errlen, "'roughness' and 'alpha' are two scales of one parameter: give one");
+        return -1;
+    }
     ggx *g = host->alloc(sizeof *g);
     if (!g)
         return -1;
@@ -260,8 +266,6 @@ static int ggx_create(const murk_host *host, const murk_value *p, void **self, c
     memcpy(g->p, p, sizeof g->p);
     g->use_alpha = p[P_ALPHA].set != 0;
     g->ms = p[P_MULTISCATTER].f[0] != 0.0;
-    if (g->use_alpha && p[P_ROUGHNESS].set && host->log)
-        host->log(MURK_LOG_WARN, "ggx: both 'roughness' and 'alpha' given; 'alpha' overrides 'roughness'");
     *self = g;
     return 0;
 }

@@ -109,6 +109,10 @@ typedef enum murk_param_type {
 
 #define MURK_PARAM_TEXTURABLE 1u /* the value may be a texture ({ checker: ... } / { image: ... }) */
 #define MURK_PARAM_REQUIRED 2u   /* the scene must give it */
+/* Another scale of the parameter just before it in the schema (ggx's alpha beside roughness, alpha =
+ * roughness^2): a scene gives one or the other. The loader refuses both, located at the second key;
+ * murk check gives each in turn. A host that predates the flag ignores it (create() should refuse both). */
+#define MURK_PARAM_ALT_SCALE 4u
 
 typedef struct murk_param {
     const char *name;

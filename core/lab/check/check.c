@@ -476,6 +476,11 @@ static int param_set(const murk_plugin_desc *d, int which, char *out, size_t out
         const murk_param *p = &d->params[i];
         if (!(p->max > p->min) || !(p->max - p->min <= 1e3))
             continue;
+        /* two scales of one parameter (MURK_PARAM_ALT_SCALE): set 1 gives the first, set 2 the other */
+        if (which == 1 && (p->flags & MURK_PARAM_ALT_SCALE))
+            continue;
+        if (which == 2 && i + 1 < d->nparams && (d->params[i + 1].flags & MURK_PARAM_ALT_SCALE))
+            continue;
         double f[3] = {which == 1 ? 0.25 : 0.75, which == 1 ? 0.5 : 0.6, which == 1 ? 0.75 : 0.3};
         double v[3];
         for (int ch = 0; ch < 3; ch++)

@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""figure4.py — the reference report's Figure 4 as the report set it: spectral tracking against the naive
+per-channel baseline on heterogeneous chromatic media, the baseline rendered in three passes, one per
+channel (naive_spectral `channel: red|green|blue`, put together by bench/three_pass.py), at equal spp per
+channel. Beside them murk's own one-render naive baseline (a hero channel per path) and spectral MIS.
+
+Timing protocol: ROUNDS interleaved rounds (every variant once per round, in a rotated order, each round
+with its own seed), the load average recorded before and after each render; per variant the median
+render time with its spread (smallest-largest), the density lookups (machine-independent work) and the
+relMSE against a reference (spectral_mis, another seed). A ratio is called resolved only when the
+spreads of the two variants' times do not overlap.
+
+    bench/figure4.py [--scale S] [--rounds R] [--spp N] [--res N] [--out DIR] [--docs DIR]
+
+writes DIR/fig4_SCENE.png strips (the first round's images) and DIR/fig4_table.md, with --md FILE also
+into FILE between its fig4 table markers (docs/gallery.md's Figure 4), and the renders to --out. Needs Debian's python3-numpy and
+python3-matplotlib."""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MURK = os.environ.get("MURK", os.path.join(ROOT, "build", "core", "murk"))
+PY = "/usr/bin/python3"
+SCENES = ["absorption", "scattering", "extinction"]
+# the medium as the report had it: heterogeneous, a procedural cloud filling the sphere's box
+HETERO = "media.medium.density={cloud: {min: [-0.6, 0.1, -0.6], max: [0.6, 1.3, 0.6], seed: 3, frequency: 3}}"
+VARIANTS = ["naive3", "naive_spectral", "spectral", "spectral_mis"]
+LABEL = {"naive3": "naive, three passes (the report's)", "naive_spectral": "naive, hero per path (murk's)",
+         "spectral": "spectral tracking", "spectral_mis": "spectral MIS"}
+CAPTION = {"naive3": "naive, 3 passes\\n(the report's)", "naive_spectral": "naive, hero\\nper path (murk's)",
+           "spectral": "spectral\\ntracking", "spectral_mis": "spectral\\nMIS"}
+
+
+def load():
+    with open("/proc/loadavg") as f:
+        return float(f.read().split()[0])
+
+
+def render(scene, out, spp, res, seed, sets):
+    cmd = [MURK, "render", scene, "-o", out, "--spp", str(spp), "--quiet", "--set", "render.resolution=[%d,%d]" % (res, res),
+           "--set", "render.seed=%d" % seed, "--set", HETERO]
+    for s in sets:
+        cmd += ["--set", s]
+    subprocess.run(cmd, check=True)
+
+
+def compare(test, ref):
+    out = subprocess.run([MURK, "compare", test, ref, "--json"], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+def one(variant, scene, base, spp, res, seed, ref):
+    """Renders one variant; its relMSE, seconds and lookups, and the load before and after."""
+    l0 = load()
+    if variant == "naive3":
+        secs = looks = 0.0
+        passes = []
+        for ch in ("red", "green", "blue"):
+            p = "%s_%s.exr" % (base, ch)
+            render(scene, p, spp, res, seed, ["media.medium.type=naive_spectral", "media.medium.channel=" + ch])
+            c = compare(p, ref)
+            secs += c["seconds"]
+            looks += c["lookups"]
+            passes.append(p)
+        subprocess.run([PY, os.path.join(ROOT, "bench", "three_pass.py"), base + ".exr"] + passes, check=True)
+        rel = compare(base + ".exr", ref)["relmse"]
+    else:
+        render(scene, base + ".exr", spp, res, seed, ["media.medium.type=" + variant])
+        c = compare(base + ".exr", ref)
+        rel, secs, looks = c["relmse"], c["seconds"], c["lookups"]
+    return {"relmse": rel, "seconds": secs, "lookups": looks, "load": (l0, load())}
+
+
+def fmt_med(xs, spec):
+    return (spec + " [" + spec + "–" + spec + "]") % (statistics.median(xs), min(xs), max(xs))
+
+
+def make_strip(a, s, spp, rel):
+    """DOCS/fig4_SCENE.png: round 0's images side by side, each with its relMSE."""
+    strip = [os.path.join(a.out, "%s_%s_r0.png" % (s, v)) + ":" + CAPTION[v] + "\\nrelMSE %.3g" % rel[v]
+             for v in VARIANTS]
+    subprocess.run([PY, os.path.join(ROOT, "bench", "strip.py"), "--title",
+                    "Fig. 4, %s: %d spp/channel" % (s, spp), os.path.join(a.docs, "fig4_%s.png" % s)] + strip,
+                   check=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scale", type=float, default=1.0, help="multiplies spp and reference spp")
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--spp", type=int, default=16, help="spp per pass / per render")
+    ap.add_argument("--ref-spp", type=int, default=512)
+    ap.add_argument("--res", type=int, default=128)
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "fig4"))
+    ap.add_argument("--docs", default=os.path.join(ROOT, "docs", "gallery"))
+    ap.add_argument("--md", help="splice the table into this markdown file, between its markers "
+                    "'<!-- fig4 table: generated by bench/figure4.py -->' and '<!-- end fig4 table -->'")
+    ap.add_argument("--strips-only", action="store_true", help="redraw the strips from round 0's renders in --out")
+    a = ap.parse_args()
+    spp = max(1, round(a.spp * a.scale))
+    if a.strips_only:
+        for s in SCENES:
+            ref = os.path.join(a.out, "%s_ref.exr" % s)
+            make_strip(a, s, spp, {v: compare(os.path.join(a.out, "%s_%s_r0.exr" % (s, v)), ref)["relmse"]
+                                   for v in VARIANTS})
+        return
+    ref_spp = max(2, round(a.ref_spp * a.scale))
+    os.makedirs(a.out, exist_ok=True)
+    os.makedirs(a.docs, exist_ok=True)
+    rows = ["| scene | variant | spp per channel | time, median [min–max] | density lookups | relMSE, median "
+            "[min–max] | load before–after |", "|---|---|---|---|---|---|---|"]
+    verdicts = []
+    for s in SCENES:
+        scene = os.path.join(ROOT, "scenes", "spectral_%s.yaml" % s)
+        ref = os.path.join(a.out, "%s_ref.exr" % s)
+        render(scene, ref, ref_spp, a.res, 1000, ["media.medium.type=spectral_mis"])
+        res = {v: [] for v in VARIANTS}
+        for r in range(a.rounds):
+            order = VARIANTS[r % len(VARIANTS):] + VARIANTS[:r % len(VARIANTS)]
+            for v in order:
+                res[v].append(one(v, scene, os.path.join(a.out, "%s_%s_r%d" % (s, v, r)), spp, a.res, r, ref))
+        for v in VARIANTS:
+            x = res[v]
+            per_channel = spp if v in ("naive3", "spectral", "spectral_mis") else "%d (hero: ~%.3g)" % (spp, spp / 3)
+            rows.append("| %s | %s | %s | %s s | %.3g | %s | %.1f–%.1f |" % (
+                s, LABEL[v], per_channel, fmt_med([y["seconds"] for y in x], "%.2f"),
+                statistics.median([y["lookups"] for y in x]), fmt_med([y["relmse"] for y in x], "%.3g"),
+                min(y["load"][0] for y in x), max(y["load"][1] for y in x)))
+        tn = [y["seconds"] for y in res["naive3"]]
+        ts = [y["seconds"] for y in res["spectral"]]
+        ratio = statistics.median(tn) / statistics.median(ts)
+        lratio = statistics.median([y["lookups"] for y in res["naive3"]]) / statistics.median(
+            [y["lookups"] for y in res["spectral"]])
+        resolved = min(tn) > max(ts) or max(tn) < min(ts)
+        verdicts.append("- %s: three-pass naive / spectral = **%.2f×** the time (%s), %.2f× the density lookups" % (
+            s, ratio, "resolved: the spreads do not overlap" if resolved else "NOT resolved: the spreads overlap",
+            lratio))
+        make_strip(a, s, spp, {v: res[v][0]["relmse"] for v in VARIANTS})
+    with open(os.path.join(a.docs, "fig4_table.md"), "w") as f:
+        f.write("<!-- generated by bench/figure4.py (--scale %g --rounds %d --spp %d --res %d): do not edit -->\n"
+                % (a.scale, a.rounds, a.spp, a.res))
+        f.write("\n".join(rows) + "\n\n" + "\n".join(verdicts) + "\n")
+    print("\n".join(rows + [""] + verdicts))
+    if a.md:
+        splice(a.md, "\n".join(rows) + "\n\n" + "\n".join(verdicts) + "\n")
+
+
+def splice(path, text):
+    """Replaces the text between the fig4 table markers of the markdown file at path."""
+    begin, end = "<!-- fig4 table: generated by bench/figure4.py -->", "<!-- end fig4 table -->"
+    with open(path) as f:
+        md = f.read()
+    i, j = md.find(begin), md.find(end)
+    if i < 0 or j < i:
+        sys.exit("figure4.py: %s has no fig4 table markers" % path)
+    with open(path, "w") as f:
+        f.write(md[:i + len(begin)] + "\n" + text + md[j:])
+
+
+if __name__ == "__main__":
+    main()
