@@ -91,18 +91,24 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
     float factor;
     murk_density_parts(nm->density, &f, &g, &factor);
     int res[3];
-    const float *data;
-    murk_field_grid(f, res, &data);
+    murk_field_grid(f, res, NULL);
+    murk_field_info fi;
+    murk_field_describe(f, &fi);
+    murk_vec3 lo, hi;
+    murk_field_bounds(f, &lo, &hi, NULL);
     printf("    density        ");
     if (dn)
         put_node(dn, NULL, 0);
     else
         printf("{ constant: 1 } (default)");
-    if (data)
-        printf(": grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g], max %g", res[0], res[1], res[2], g->lo.x,
-               g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z, murk_field_max(f));
+    if (fi.grid)
+        printf(": %s grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g]%s, max %g", fi.sparse ? "sparse" : "dense",
+               res[0], res[1], res[2], lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+               fi.transformed ? " (a rotated box: its bound grid is in index space)" : "", murk_field_max(f));
     else
         printf(": constant %g, everywhere", murk_field_max(f));
+    if (fi.sparse)
+        printf("\n                   %llu active voxels in %zu bricks of 8^3", (unsigned long long)fi.active, fi.bricks);
     float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s));
     printf("\n    majorant       %dx%dx%d cells, majorant_factor %g; largest majorant %g (extinction %g x density "
            "%g x factor)\n", g->res[0], g->res[1], g->res[2], factor,

@@ -10,6 +10,7 @@
 #include "host.h"
 #include "limit.h"
 #include "media.h"
+#include "media/source.h"
 #include "obj.h"
 #include "params.h"
 #include "util.h"
@@ -618,7 +619,7 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
         if (names(shapes->items[i], "type", "mesh") && hash_input(s, murk_ymap_get(shapes->items[i], "file"), &h, err, errlen))
             return 0;
     for (size_t i = 0; media && i < media->n; i++) /* density grids */
-        if (hash_input(s, murk_ymap_get(murk_ymap_get(media->items[i], "density"), "grid"), &h, err, errlen))
+        if (hash_input(s, murk_field_node_file(murk_ymap_get(media->items[i], "density")), &h, err, errlen))
             return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;
