@@ -8,7 +8,7 @@ BUILD=${MURK_BUILD_DIR:-build}
 # Build, test and data dependencies, all from Debian 12's own archive.
 PKGS="gcc meson ninja-build pkg-config cmake libembree-dev libopenexr-dev libyaml-dev libpng-dev
       libcmocka-dev libnanovdb-dev glmark2-data python3 python3-matplotlib python3-numpy clang libclang-rt-14-dev
-      openmpi-bin libopenmpi-dev"
+      openmpi-bin libopenmpi-dev g++ libopenvdb-dev"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
