@@ -139,26 +139,36 @@ static inline float trilinear(const float v[8], const float w[3])
 }
 
 /* The 8 values around box voxel i0 of a sparse grid (d: 0 or 1 per axis, the step to the far corner).
- * When the 2 x 2 x 2 block lies in one brick (7 times in 8 per axis) one brick lookup serves all. */
+ * When the 2 x 2 x 2 block lies in one brick (7 times in 8 per axis) one brick lookup serves all; otherwise
+ * only the distinct bricks it touches (2, 4 or 8) are looked up. */
 static inline void sparse_corners(const murk_sparse *s, const int i0[3], const int d[3], float v[8])
 {
     int x = i0[0] + s->off[0], y = i0[1] + s->off[1], z = i0[2] + s->off[2];
-    if ((x & 7) + d[0] <= 7 && (y & 7) + d[1] <= 7 && (z & 7) + d[2] <= 7) {
-        const float *b = murk_sparse_brick(s, i0[0], i0[1], i0[2]);
-        int o = murk_sparse_slot(s, i0[0], i0[1], i0[2]), sx = d[0] << 6, sy = d[1] << 3, sz = d[2];
-        v[0] = b[o];
-        v[1] = b[o + sx];
-        v[2] = b[o + sy];
-        v[3] = b[o + sx + sy];
-        v[4] = b[o + sz];
-        v[5] = b[o + sx + sz];
-        v[6] = b[o + sy + sz];
-        v[7] = b[o + sx + sy + sz];
+    int cx = (x & 7) + d[0] > 7, cy = (y & 7) + d[1] > 7, cz = (z & 7) + d[2] > 7;
+    const float *b0 = murk_sparse_brick(s, i0[0], i0[1], i0[2]);
+    int o = murk_sparse_slot(s, i0[0], i0[1], i0[2]);
+    if (!(cx | cy | cz)) {
+        int sx = d[0] << 6, sy = d[1] << 3, sz = d[2];
+        v[0] = b0[o];
+        v[1] = b0[o + sx];
+        v[2] = b0[o + sy];
+        v[3] = b0[o + sx + sy];
+        v[4] = b0[o + sz];
+        v[5] = b0[o + sx + sz];
+        v[6] = b0[o + sy + sz];
+        v[7] = b0[o + sx + sy + sz];
         return;
     }
+    const float *b[8];
+    b[0] = b0;
+    b[1] = cx ? murk_sparse_brick(s, i0[0] + 1, i0[1], i0[2]) : b0;
+    b[2] = cy ? murk_sparse_brick(s, i0[0], i0[1] + 1, i0[2]) : b0;
+    b[3] = cy ? (cx ? murk_sparse_brick(s, i0[0] + 1, i0[1] + 1, i0[2]) : b[2]) : b[1];
+    for (int k = 4; k < 8; k++) /* the far z layer: the same bricks, or the next brick along z */
+        b[k] = cz ? murk_sparse_brick(s, i0[0] + (k & 1) * d[0], i0[1] + ((k >> 1) & 1) * d[1], i0[2] + 1) : b[k - 4];
     for (int k = 0; k < 8; k++) {
-        int cx = i0[0] + (k & 1) * d[0], cy = i0[1] + ((k >> 1) & 1) * d[1], cz = i0[2] + (k >> 2) * d[2];
-        v[k] = murk_sparse_brick(s, cx, cy, cz)[murk_sparse_slot(s, cx, cy, cz)];
+        int px = (x + (k & 1) * d[0]) & 7, py = (y + ((k >> 1) & 1) * d[1]) & 7, pz = (z + (k >> 2) * d[2]) & 7;
+        v[k] = b[k][px << 6 | py << 3 | pz];
     }
 }
 
