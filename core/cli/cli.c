@@ -596,6 +596,7 @@ static int render_main(int argc, char **argv)
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
         murk_cli_counters_print(stdout, s, &res);
+        murk_cli_memory_print(stdout, s, 0);
     }
     murk_warn_summary();
     if (res.nonfinite)

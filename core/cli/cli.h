@@ -37,6 +37,9 @@ int murk_cli_bench(int argc, char **argv);   /* bench.c */
 #include "murk/murk.h"
 void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n);
 void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r);
+/* What the scene holds in memory (info.c): every grid, mesh, texture and Embree's scene with its bytes when
+ * detail, else one line of totals per kind; then the process's peak resident memory. */
+void murk_cli_memory_print(FILE *f, const struct murk_scene *s, int detail);
 
 /* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */
 int murk_cli_merge(int argc, char **argv);

@@ -170,6 +170,56 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
     }
 }
 
+/* Bytes in binary units: "512 B", "3.4 KiB", "139.8 MiB". */
+static const char *bytes_text(char *buf, size_t n, uint64_t b)
+{
+    static const char *const unit[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    double v = (double)b;
+    int u = 0;
+    while (v >= 1024.0 && u < 4)
+        v /= 1024.0, u++;
+    snprintf(buf, n, u ? "%.1f %s" : "%.0f %s", v, unit[u]);
+    return buf;
+}
+
+void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
+{
+    size_t n = murk_scene_memory(s, NULL, 0);
+    murk_mem_item *it = murk_xmalloc((n ? n : 1) * sizeof *it);
+    murk_scene_memory(s, it, n);
+    static const char *const kinds[] = {"grid", "mesh", "texture", "embree"};
+    static const char *const plural[] = {"grids", "meshes", "textures", "Embree"};
+    uint64_t total[4] = {0}, all = 0;
+    size_t count[4] = {0};
+    char b1[32], b2[32];
+    if (detail)
+        fprintf(f, "memory (bytes held as allocated; README, Limits)\n");
+    for (size_t i = 0; i < n; i++) {
+        for (int k = 0; k < 4; k++)
+            if (!strcmp(it[i].kind, kinds[k]))
+                total[k] += it[i].bytes, count[k]++;
+        all += it[i].bytes;
+        if (detail)
+            fprintf(f, "  %-8s %-24s %10s  %s\n", it[i].kind, murk_cli_q(it[i].name), bytes_text(b1, sizeof b1, it[i].bytes),
+                    murk_cli_q(it[i].detail));
+    }
+    long peak = murk_peak_rss_kb();
+    if (detail) {
+        fprintf(f, "  %-33s %10s\n", "total", bytes_text(b1, sizeof b1, all));
+        if (peak >= 0)
+            fprintf(f, "  peak resident memory of this process (VmHWM) %s\n", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
+    } else {
+        fprintf(f, "memory:");
+        for (int k = 0; k < 4; k++)
+            fprintf(f, "%s %s %s%s", k ? "," : "", plural[k], bytes_text(b1, sizeof b1, total[k]),
+                    k < 3 ? (count[k] ? "" : "") : "");
+        if (peak >= 0)
+            fprintf(f, "; peak resident %s", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
+        fputc('\n', f);
+    }
+    free(it);
+}
+
 murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets)
 {
     char err[2048];
@@ -225,6 +275,7 @@ int murk_cli_info(int argc, char **argv)
         return 1;
     }
     info_scene(s, scene_path, sets, nsets);
+    murk_cli_memory_print(stdout, s, 1);
     murk_scene_free(s);
     free(sets);
     return 0;

@@ -522,19 +522,6 @@ static void sum_over_ranks(job *j, int nthreads, murk_render_result *out)
     murk_mpi_max_double(&j->max_sample);
 }
 
-/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
-static long peak_rss_kb(void)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    long kb = -1;
-    while (f && fgets(line, sizeof line, f))
-        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
-            break;
-    if (f)
-        fclose(f);
-    return kb;
-}
 
 /* A rank other than 0: renders the passes rank 0 announces, the tiles it hands out, until it says end.
  * Its memory is its nthreads + 1 held tiles' (7 KB each), whatever the image's size. */
@@ -567,7 +554,7 @@ static int follow_passes(job *j, int nthreads, murk_render_result *out)
         free(j->held[k]);
     free(j->held);
     if (getenv("MURK_MPI_STATS")) /* what this rank held at most (tests/test_mpi.c) */
-        fprintf(stderr, "murk: mpi: rank %d: peak resident memory %ld kB\n", murk_mpi_rank(), peak_rss_kb());
+        fprintf(stderr, "murk: mpi: rank %d: peak resident memory %ld kB\n", murk_mpi_rank(), murk_peak_rss_kb());
     if (pm.cmd == PASS_END)
         sum_over_ranks(j, nthreads, out);
     out->spp = pm.spp0;

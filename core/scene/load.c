@@ -313,6 +313,7 @@ static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *e
     free(path);
     if (rc != 0)
         return ERR(f, "mesh: %s", merr);
+    sh->name = murk_strdup(file);
     sh->nverts = mesh.nverts;
     sh->ntris = mesh.ntris;
     sh->pos = mesh.pos;

@@ -13,6 +13,7 @@ void murk_shape_free(murk_shape *sh)
     free(sh->nrm);
     free(sh->ng);
     free(sh->idx);
+    free(sh->name);
 }
 
 MURK_API void murk_scene_free(murk_scene *s)

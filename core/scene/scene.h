@@ -28,6 +28,7 @@ typedef struct murk_shape {
     uint32_t *idx;                             /* 3*ntris */
     murk_vec3 center;                          /* sphere */
     float radius;
+    char *name;                                /* mesh: its file as the scene names it (owned), else NULL */
 } murk_shape;
 
 typedef struct murk_light {
@@ -95,6 +96,7 @@ struct murk_scene {
     float light_power;
     RTCDevice device;
     RTCScene rtc;
+    long long embree_bytes; /* what Embree holds for the scene (its memory monitor: BVH, buffers) */
 };
 
 /* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
@@ -111,5 +113,20 @@ uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
 
 /* Releases what a shape owns (its triangle arrays). */
 void murk_shape_free(murk_shape *sh);
+
+/* What a loaded scene holds in memory, item by item (memory.c): each medium's density field with its bound grid,
+ * each mesh (positions, uvs, normals, indices, triangle normals), each texture (texels as floats), and Embree's
+ * scene (its BVH and its copies of the buffers, as its memory monitor counts them). Bytes as allocated, without
+ * the allocator's own overhead. */
+typedef struct murk_mem_item {
+    const char *kind;   /* "grid", "mesh", "texture", "embree" */
+    char name[160];     /* the medium, the file, or "scene" */
+    char detail[160];   /* e.g. "sparse, 32221669 active voxels in 68051 bricks" */
+    uint64_t bytes;
+} murk_mem_item;
+/* Fills items[0..cap) and returns how many there are (it may exceed cap: call again with more room). */
+size_t murk_scene_memory(const murk_scene *s, murk_mem_item *items, size_t cap);
+/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
+long murk_peak_rss_kb(void);
 
 #endif
