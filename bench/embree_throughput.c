@@ -23,7 +23,7 @@
  *   murk    `murk render` with the scene's integrator at --threads 1 (camera rays, NEE shadow rays, BSDF
  *           rays, shading, sampling, film), its rays counted as murk counts them.
  * The Embree sides generate or convert their rays outside the timed part; the murk side times everything
- * murk does (per render too: thread start, film, under 1 ms of a 1-s side).
+ * murk does (per render too: thread start and film, small against a 1-s side).
  *
  * The machine's speed drifts (shared, turbo, neighbours), so the sides are measured in several short
  * interleaved rounds — raw, replay, the rungs, murk, then the same in reverse, ... — each round gives one
@@ -37,8 +37,8 @@
  * boundaries, an intersection along the same segment to tell a surface from a boundary; both are rays,
  * counted once each by murk and replayed once each. But murk's rays are cheaper for Embree than the raw
  * side's — its camera rays are coherent and a third of its calls are occlusion queries cut at the light —
- * so the replay runs about 1.4x as many rays per second as the raw side on the Cornell box, and murk / raw
- * flatters murk by that much. murk / replay is the like-for-like ratio (the same Embree work on both
+ * so the replay runs more rays per second than the raw side, and murk / raw flatters murk by that factor
+ * (bench/throughput.md has it). murk / replay is the like-for-like ratio (the same Embree work on both
  * sides); it is also the share of murk's time spent inside Embree. Both are printed; the issue's goal
  * (70 %) was stated against raw. bench/throughput.md has the figures and where the rest of murk's time
  * goes.
@@ -51,10 +51,10 @@
  * end at the same t), so the ratio of flights/s is the ratio of tracker steps/s; the bare loop's steps
  * (tentative collisions + majorant cells) per second are printed too. Interleaved rounds as above, timed
  * in the thread's CPU seconds (CLOCK_THREAD_CPUTIME_ID). */
-#include "camera.h"
-#include "host.h"
-#include "scene.h"
-#include "util.h"
+#include "render/camera.h"
+#include "render/host.h"
+#include "scene/scene.h"
+#include "util/util.h"
 
 #include "murk/tracking.h"
 

@@ -23,11 +23,11 @@
  *   eff_time    the same at equal time
  * The error of the mean of n estimates is sqrt(bias2 + var / n); plot.py draws it against n x lookups
  * and n x time, so a biased estimator flattens at its floor sqrt(bias2). */
-#include "host.h"
-#include "media.h"
-#include "plugin_loader.h"
-#include "scene.h"
-#include "util.h"
+#include "media/media.h"
+#include "plugin/plugin_loader.h"
+#include "render/host.h"
+#include "scene/scene.h"
+#include "util/util.h"
 
 #include "murk/transmittance.h"
 

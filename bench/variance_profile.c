@@ -37,11 +37,12 @@
  * and the seconds per sample (this loop, one thread, the tap included) end the table. --csv prints the
  * same numbers as CSV. Deterministic: a function of the scene (seed included), crop, stride and spp. */
 #include "pathtracer.h"
-#include "scene.h"
-#include "util.h"
+#include "pathtracer_tap.h"
+#include "scene/scene.h"
+#include "util/util.h"
 
-#include "camera.h"
-#include "host.h"
+#include "render/camera.h"
+#include "render/host.h"
 
 #include <math.h>
 #include <stdio.h>

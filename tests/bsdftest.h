@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "murk/material.h"
-#include "sphere.h"
+#include "check/sphere.h"
 #include "testutil.h"
 
 /* ---- Instances ------------------------------------------------------------------------------- */

@@ -7,10 +7,11 @@
 
 #include "testutil.h"
 
-#include "density.h"
-#include "host.h"
-#include "media.h"
-#include "scene.h"
+#include "media/density.h"
+#include "render/host.h"
+#include "media/media.h"
+#include "util/runtime.h"
+#include "scene/scene.h"
 
 /* ---- scenes ----------------------------------------------------------------------------------- */
 

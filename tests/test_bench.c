@@ -4,7 +4,7 @@
  * and maps, and a bench interrupted by SIGINT/SIGTERM (whole rows only, nothing half-written). */
 #include "testutil.h"
 
-#include "metrics.h"
+#include "cli/metrics.h"
 #include "murk/murk.h"
 
 #include <dirent.h>
@@ -81,7 +81,8 @@ static void bench_end_to_end(void **state)
     static const char *const files[] = {"bench.csv", "bench.json", "report.md", "error_vs_time.png",
                                         "error_vs_time.svg", "error_vs_lookups.png", "error_vs_lookups.svg",
                                         "efficiency.png", "efficiency.svg", "efficiency_map.png",
-                                        "efficiency_map.svg", "maps/variant0.npy", "maps/variant1.npy"};
+                                        "efficiency_map.svg", "maps/variant0.npy", "maps/variant1.npy",
+                                        "report.html"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
         if (!exists(out1, files[i]))
             fail_msg("murk bench did not write %s/%s:\n%s", out1, files[i], out);

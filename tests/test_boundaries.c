@@ -28,9 +28,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host.h"
+#include "render/host.h"
 #include "pathtracer.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 #ifndef NEE_RES
 #define NEE_RES 32

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "density.h"
+#include "media/density.h"
 
 static char err[1024];
 

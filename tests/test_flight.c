@@ -21,7 +21,7 @@
  * deterministic count over 2^k samples) and the first flight's distance in heterogeneous media (the
  * cloud, a dense grid, a plateau) against the closed form, sharp enough for a first flight 5% short. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 #include "mediatest.h"
 
 #include "murk/math.h"

@@ -9,7 +9,7 @@
  *  - the textures load with their expected sizes, and murk's sRGB decoding of them is the sRGB
  *    transfer function of the raw 8-bit values. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -29,9 +29,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "host.h"
+#include "render/host.h"
 #include "pathtracer.h"
-#include "scene.h"
+#include "scene/scene.h"
 
 #define PI 3.14159265358979323846
 

@@ -7,7 +7,7 @@
  * interlaced files made here with libpng, and broken files. */
 #include "testutil.h"
 
-#include "image.h"
+#include "image/image.h"
 #include "murk/math.h"
 
 #include <dirent.h>

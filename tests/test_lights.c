@@ -12,8 +12,8 @@
  * Then points on the lamp itself, which it must not light (the cause of issue 15's solid_angle bias), and
  * the report's image test: test_boundaries' box scene with solid_angle against area, block-wise z. */
 #include "testutil.h"
-#include "host.h"
-#include "scene.h"
+#include "render/host.h"
+#include "scene/scene.h"
 
 #include "murk/math.h"
 

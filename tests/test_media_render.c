@@ -19,7 +19,7 @@
  * furnace and slab images estimates the same value), per channel; each such check also asserts that
  * a 3% error would be >= 5 se, and prints mean +- se (expected). */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdarg.h>

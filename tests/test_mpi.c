@@ -9,7 +9,7 @@
  * pixel from a 64x64 to a 2048x2048 image. Skipped (exit 77) when murk is built without MPI or mpirun is
  * missing. The ranks run on this machine, oversubscribed (--oversubscribe), as root when need be
  * (OMPI_ALLOW_RUN_AS_ROOT). */
-#include "image.h"
+#include "image/image.h"
 #include "testutil.h"
 
 #include <stdio.h>

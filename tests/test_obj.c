@@ -6,7 +6,7 @@
  * glmark2 bunny when it is installed. */
 #include "testutil.h"
 
-#include "obj.h"
+#include "scene/obj.h"
 
 #include <locale.h>
 #include <math.h>

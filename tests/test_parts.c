@@ -5,7 +5,7 @@
  * fail with a message naming the culprit, and leave no output. And the other way to spread work over
  * a batch scheduler (issue 13, item 3): `murk bench --emit-jobs`, its jobs run by a shell loop and
  * assembled, gives the in-process bench's rows. */
-#include "image.h"
+#include "image/image.h"
 #include "testutil.h"
 
 #include <stdio.h>

@@ -1,11 +1,11 @@
-/* test_plugin_abi.c — the plugin loader (core/plugin.c) against the fixture plugins in
+/* test_plugin_abi.c — the plugin loader (core/plugin/plugin.c) against the fixture plugins in
  * tests/fixtures (built into the build's tests/fixtures folder, reached only through MURK_PLUGIN_PATH):
  * every refusal is rc -1 with one precise line naming the file; plugin code is never run before the
  * ABI check (abi_major/abi_minor/no_abi abort() if their entry is called); only the plugins a scene
  * names are loaded; `murk render` / `murk plugins` report the same; an empty MURK_PLUGIN_PATH entry
  * never means the current folder. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <dlfcn.h>
 #include <stdio.h>
@@ -14,8 +14,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "plugin_loader.h"
-#include "scene.h"
+#include "plugin/plugin_loader.h"
+#include "scene/scene.h"
+
+/* The host's ABI minor as text (and the next one, which the abi_minor fixture asks for). */
+#define STR_(x) #x
+#define STR(x) STR_(x)
+#define MINOR STR(MURK_ABI_MINOR)
+_Static_assert(MURK_ABI_MINOR == 8, "update MINOR_PLUS_1 with the ABI minor");
+#define MINOR_PLUS_1 "9"
 
 static char err[2048];
 
@@ -78,8 +85,8 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case bad_cases[] = {
-    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1.6"},
-    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1.7, this murk has ABI 1.6"},
+    {"abi_major", MURK_KIND_MATERIAL, "built for plugin ABI 2.0, this murk has ABI 1." MINOR},
+    {"abi_minor", MURK_KIND_MATERIAL, "needs plugin ABI 1." MINOR_PLUS_1 ", this murk has ABI 1." MINOR},
     {"no_entry", MURK_KIND_MATERIAL, "no 'murk_plugin_entry' function"},
     {"no_abi", MURK_KIND_MATERIAL, "no 'murk_plugin_abi' symbol: not a murk plugin"},
     {"bad_size", MURK_KIND_MATERIAL, "descriptor struct_size is"},
@@ -121,7 +128,7 @@ static void test_open_bad_details(void **state)
     murk_plugin p;
     char want[256];
     assert_int_equal(murk_plugin_open(fixture("bad_size"), 0, &p, err, sizeof err), -1);
-    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1.6",
+    snprintf(want, sizeof want, "descriptor struct_size is %zu bytes, expected at least %zu for ABI 1." MINOR,
              MURK_PLUGIN_DESC_SIZE_1_0 - sizeof(void *), MURK_PLUGIN_DESC_SIZE_1_0);
     assert_contains(err, want);
 
@@ -181,7 +188,7 @@ static void test_open_not_a_library(void **state)
     /* another major ABI with an aborting constructor: refused from the symbol table, never loaded */
     const char *ctor = fixture("abi_ctor");
     assert_int_equal(murk_plugin_open(ctor, 0, &p, err, sizeof err), -1);
-    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1.6");
+    assert_contains(err, "built for plugin ABI 2.0, this murk has ABI 1." MINOR);
     assert_null(strchr(err, '\n'));
 }
 
@@ -483,6 +490,33 @@ static void test_old_minor(void **state)
     murk_image_free(&img);
 }
 
+/* A material without the prepared methods of ABI 1.7 (good_fixture: a grey Lambertian whose vtable leaves
+ * them NULL) goes through the hit-based methods and renders the same pixels, bit for bit, as the
+ * built-in diffuse of the same albedo through prepare(): the integrators' fallback changes nothing. */
+static void test_unprepared_material_renders_like_prepared(void **state)
+{
+    (void)state;
+    setenv("MURK_PLUGIN_PATH", fixture_dir(), 1);
+    const char *scenes[2] = {scene_using("cli_unprepared", "good_fixture", ", grey: 0.5"),
+                             scene_using("cli_prepared", "diffuse", ", albedo: 0.5")};
+    murk_image img[2];
+    for (int k = 0; k < 2; k++) {
+        char exr[1100];
+        snprintf(exr, sizeof exr, "%s/prepared%d.exr", tmp_dir(), k);
+        char *out = NULL;
+        int st = run_murk(&out, "render", scenes[k], "-o", exr, "--spp", "16", "--quiet", NULL);
+        if (st != 0)
+            fail_msg("%s: status %d:\n%s", scenes[k], st, out);
+        free(out);
+        assert_int_equal(murk_exr_read(exr, &img[k], err, sizeof err), 0);
+    }
+    assert_int_equal(img[0].w, img[1].w);
+    assert_int_equal(img[0].h, img[1].h);
+    assert_memory_equal(img[0].rgb, img[1].rgb, sizeof(float) * 3 * (size_t)img[0].w * (size_t)img[0].h);
+    murk_image_free(&img[0]);
+    murk_image_free(&img[1]);
+}
+
 static void test_cli_render_fixtures(void **state)
 {
     (void)state;
@@ -541,7 +575,7 @@ static void test_cli_render_fixtures(void **state)
     const char *plugins = murk_image_meta(&img, "murk:plugins");
     assert_non_null(plugins);
     char rec[1300];
-    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1.6)", fixture("good_fixture"));
+    snprintf(rec, sizeof rec, "good_fixture=%s (version none, ABI 1." MINOR ")", fixture("good_fixture"));
     assert_contains(plugins, rec);
     assert_contains(plugins, "path=");
     murk_image_free(&img);
@@ -642,7 +676,7 @@ static void test_cli_plugins(void **state)
     free(out);
     st = run_murk(&out, "plugins", "abi_major", NULL);
     assert_int_equal(st, 1);
-    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1.6");
+    assert_contains(out, "built for plugin ABI 2.0, this murk has ABI 1." MINOR);
     assert_contains(out, fixture("abi_major"));
     free(out);
     st = run_murk(&out, "plugins", "good_fixture", NULL);
@@ -667,6 +701,7 @@ int main(void)
         cmocka_unit_test(test_cli_render_fixtures),
         cmocka_unit_test(test_cli_crash),
         cmocka_unit_test(test_old_minor),
+        cmocka_unit_test(test_unprepared_material_renders_like_prepared),
         cmocka_unit_test(test_cli_nan_culprit),
         cmocka_unit_test(test_cli_plugins),
     };

@@ -21,13 +21,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "atomic.h"
-#include "host.h"
-#include "scene.h"
-#include "density.h"
-#include "image.h"
-#include "limit.h"
-#include "util.h"
+#include "util/atomic.h"
+#include "render/host.h"
+#include "scene/scene.h"
+#include "media/density.h"
+#include "image/image.h"
+#include "util/limit.h"
+#include "util/util.h"
 #include "murk/medium.h"
 #include "murk/tracking.h"
 

@@ -2,7 +2,7 @@
  * against its closed form, 1-vs-2-thread bitwise determinism, and the Cornell box (finite pixels, EXR
  * metadata read back through OpenEXRCore). */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -5,7 +5,7 @@
  * signal, write the image of the spp it reached (murk:spp, murk:interrupted) or nothing, and leave no
  * temporary file behind. A checkpoint of another scene / other overrides is refused. A SIGHUP that was
  * ignored when murk started (nohup) stays ignored. */
-#include "image.h"
+#include "image/image.h"
 #include "testutil.h"
 
 #include <dirent.h>

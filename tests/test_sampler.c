@@ -6,9 +6,9 @@
  * read and checked like every scene key. And the solid-angle sampling of rectangular lights
  * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
 #include "testutil.h"
-#include "host.h"
-#include "image.h"
-#include "scene.h"
+#include "render/host.h"
+#include "image/image.h"
+#include "scene/scene.h"
 
 #include "murk/math.h"
 

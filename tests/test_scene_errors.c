@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "murk/murk.h"
-#include "util.h"
+#include "util/util.h"
 
 typedef struct bad_scene {
     const char *name;
@@ -33,7 +33,7 @@ static const bad_scene corpus[] = {
     {"unclosed bracket", "unclosed_bracket.yaml", NULL, NULL, 3, 43, 0, "did not find expected ',' or ']'"},
     {"tab indentation", "tab_indent.yaml", NULL, NULL, 4, 1, 0, "tab character: YAML indentation must use spaces"},
     {"unknown top-level key", "unknown_top_key.yaml", NULL, NULL, 5, 1, 0,
-     "unknown key 'lights' in the scene; expected one of: murk, render, camera"},
+     "unknown key 'volumes' in the scene; expected one of: murk, render, camera"},
     {"parameter typo", "param_typo.yaml", NULL, NULL, 4, 27, 0,
      "unknown parameter 'albdo' for material 'white' (diffuse) (did you mean 'albedo'?)"},
     {"string for a number", "wrong_type.yaml", NULL, NULL, 3, 65, 0, "camera.fov must be a number, got 'wide'"},

@@ -3,7 +3,7 @@
  * so the rendered pixels show the texels themselves: checker parity and PNG texels at known (u,v).
  * Also: in-process parsing errors, and a rendered GGX furnace that must not exceed 1 beyond noise. */
 #include "testutil.h"
-#include "image.h"
+#include "image/image.h"
 
 #include <math.h>
 #include <stdio.h>

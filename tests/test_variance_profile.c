@@ -15,9 +15,9 @@
 
 #include "testutil.h"
 
-#include "camera.h"
-#include "host.h"
-#include "scene.h"
+#include "render/camera.h"
+#include "render/host.h"
+#include "scene/scene.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
 /* testutil.c — see testutil.h */
 #include "testutil.h"
-#include "image.h"
-#include "sphere.h"
+#include "image/image.h"
+#include "check/sphere.h"
 
 #include <errno.h>
 #include <fcntl.h>

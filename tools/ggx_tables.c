@@ -1,7 +1,8 @@
 /* ggx_tables.c — generates the tables of two material plugins; a tool of the repository, not of the
  * plugins (tools/meson.build checks that its output equals the committed headers):
- *     ninja -C build tools/ggx_tables && ./build/tools/ggx_tables > plugins/materials/ggx_tables.h   (~10 s)
- *     ./build/tools/ggx_tables dielectric > plugins/materials/dielectric_tables.h                 (~30 s)
+ *     ninja -C build tools/ggx_tables && ./build/tools/ggx_tables > plugins/materials/ggx_tables.h
+ *     ./build/tools/ggx_tables dielectric > plugins/materials/dielectric_tables.h
+ * The GGX and Fresnel formulas it shares with the plugins come from murk/microfacet.h (in double).
  *
  * ggx_tables.h: M(mu, alpha), the directional albedo term of ggx's energy-conserving diffuse base, with
  * per-cell safety margins, and its cosine-weighted average Mavg; E(mu, alpha), the coat's
@@ -16,6 +17,8 @@
  * part counted as energy: radiance x eta^2) of the dielectric plugin's single-scattering rough model,
  * for wo on the outside (relative index eta) and on the inside (1 / eta); see
  * dielectric_main() below. */
+#include "murk/microfacet.h"
+
 #include <math.h>
 
 #define GGX_TAB_N 32         /* table size per axis */
@@ -63,7 +66,7 @@ static void gen_MEE(double mu, double alpha, int n, const double *x, const doubl
     double sx = alpha * ox, sz = oz, l = sqrt(sx * sx + sz * sz);
     sx /= l;
     sz /= l;
-    double a2 = alpha * alpha, ro = sqrt(oz * oz * (1.0 - a2) + a2);
+    double a2 = alpha * alpha, ro = murk_ggx_smith_r_d(oz, a2);
     double sm = 0.0, se = 0.0, s5 = 0.0;
     for (int i = 0; i < n; i++) {
         double cp = cos(2.0 * pi * x[i]), sp = sin(2.0 * pi * x[i]);
@@ -80,7 +83,7 @@ static void gen_MEE(double mu, double alpha, int n, const double *x, const doubl
             double mi = 2.0 * c * hz / hl - oz; /* wi.z */
             if (mi > 0.0) {
                 mi = fmin(mi, 1.0);
-                double ri = sqrt(mi * mi * (1.0 - a2) + a2);
+                double ri = murk_ggx_smith_r_d(mi, a2);
                 double g = mi * (oz + ro) / (mi * ro + oz * ri);
                 se += ww * g;
                 s5 += ww * g * t5;
@@ -316,21 +319,11 @@ typedef struct di_gen {
     int nq;
 } di_gen;
 
-static double di_fresnel(double ci, double eta)
-{ /* unpolarised, ci >= 0, eta = index beyond / index of wo's side; 1 under total internal reflection */
-    double s2t = (1.0 - ci * ci) / (eta * eta);
-    if (s2t >= 1.0)
-        return 1.0;
-    double ct = sqrt(1.0 - s2t);
-    double a = (eta * ci - ct) / (eta * ci + ct), b = (ci - eta * ct) / (ci + eta * ct);
-    return 0.5 * (a * a + b * b);
-}
-
 /* G2 / G1(wo) for an outgoing cosine m (> 0 on its own side) */
 static double di_g(const di_gen *d, double m)
 {
     m = fmin(m, 1.0);
-    double ri = sqrt(m * m * (1.0 - d->a2) + d->a2);
+    double ri = murk_ggx_smith_r_d(m, d->a2);
     return m * (d->oz + d->ro) / (m * d->ro + d->oz * ri);
 }
 
@@ -348,7 +341,7 @@ static double di_point(const di_gen *d, double u1, double e[3])
     hy /= hl;
     hz /= hl;
     double c = fmin(1.0, fmax(0.0, d->ox * hx + d->oz * hz));
-    double F = di_fresnel(c, d->eta), v = 0.0, mr = 2.0 * c * hz - d->oz;
+    double F = murk_fresnel_dielectric_cos_d(c, d->eta), v = 0.0, mr = 2.0 * c * hz - d->oz;
     e[0] = mr;
     e[1] = c - d->ccrit;
     if (mr > 0.0)
@@ -450,7 +443,7 @@ static double di_E(double mu, double alpha, double eta, int nq, const double *xq
     d.sz = mu / l;
     d.alpha = alpha;
     d.a2 = alpha * alpha;
-    d.ro = sqrt(mu * mu * (1.0 - d.a2) + d.a2);
+    d.ro = murk_ggx_smith_r_d(mu, d.a2);
     d.eta = eta;
     d.ccrit = eta < 1.0 ? sqrt(1.0 - eta * eta) : -1.0;
     d.xq = xq;

@@ -44,13 +44,14 @@
  *            `delta`) must still give 1, whether the integrator handles media or ignores them.
  *
  * Each check was seen to fail against a broken plugin (docs/plugins.md lists which). */
-#include "check.h"
+#include "check/check.h"
 
-#include "density.h"
-#include "host.h"
-#include "plugin_loader.h"
-#include "scene.h"
-#include "sphere.h"
+#include "check/sphere.h"
+#include "media/density.h"
+#include "plugin/plugin_loader.h"
+#include "render/host.h"
+#include "scene/scene.h"
+#include "util/runtime.h"
 #include "murk/murk.h"
 
 #include <errno.h>

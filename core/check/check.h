@@ -3,7 +3,7 @@
 #ifndef MURK_CHECK_H
 #define MURK_CHECK_H
 
-#include "util.h"
+#include "util/util.h"
 
 /* `murk check [--seed S] [--quick] PLUGIN...` (argv[0] is "check"). PLUGIN is a name found on the
  * plugin search path or a path to NAME.so (its folder is then searched first). Prints one line per

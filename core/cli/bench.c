@@ -1,16 +1,22 @@
 /* bench.c — `murk bench SCENE.yaml`: renders every variant (the cross product of the --vary lists) at
  * every budget (--spp or --time) with --repeat seeds, measures each render against a reference
  * (metrics.c: the noise-corrected relMSE and the rest) and its work (the cost counters), writes
- * DIR/bench.csv, DIR/bench.json and DIR/maps/, and runs the chart script (tools/bench_report.py) for
- * the charts and report.md. Also the counters' text forms (the end-of-render summary, murk:counters).
+ * DIR/bench.csv, DIR/bench.json and DIR/maps/, runs the chart script (tools/bench_report.py) for
+ * the charts and report.md, and writes DIR/report.html, the comparison page (cli/report_html.h): each
+ * variant's first-seed image at the largest budget, the reference, the error maps, charts and tables.
  * Part of the murk executable. */
-#include "atomic.h"
-#include "cli.h"
-#include "image.h"
-#include "media.h"
-#include "metrics.h"
-#include "scene.h"
-#include "util.h"
+#include "cli/cli.h"
+#include "cli/metrics.h"
+#include "cli/report_html.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/media.h"
+#include "render/counters.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,90 +35,6 @@ static double now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static uint64_t counter_get(const murk_counters *c, int k)
-{
-    const uint64_t v[MURK_NCOUNTERS] = {c->lookups, c->cells, c->collisions, c->scatters, c->shadow};
-    return v[k];
-}
-
-/* The media's counters summed. */
-static murk_counters counters_total(const murk_render_result *r)
-{
-    murk_counters t = {0};
-    for (int i = 0; i < r->nmedia; i++) {
-        t.lookups += r->media[i].lookups;
-        t.cells += r->media[i].cells;
-        t.collisions += r->media[i].collisions;
-        t.scatters += r->media[i].scatters;
-        t.shadow += r->media[i].shadow;
-    }
-    return t;
-}
-
-/* A medium's name for the counters: the scene's, or "(the rest)" for the shared last slot. */
-static const char *slot_name(const murk_scene *s, int i)
-{
-    return i == MURK_COUNTER_SLOTS - 1 && s->nmedia > MURK_COUNTER_SLOTS ? "(the rest)" : s->media[i].name;
-}
-
-static size_t json_counters(char *buf, size_t n, size_t k, const murk_counters *c)
-{
-    for (int i = 0; i < MURK_NCOUNTERS && k < n; i++)
-        k += (size_t)snprintf(buf + k, n - k, "%s\"%s\": %llu", i ? ", " : "{", counter_names[i],
-                              (unsigned long long)counter_get(c, i));
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, "}");
-    return k;
-}
-
-/* The media's counters as JSON: {"rays": N, "total": {...}, "media": {"NAME": {...}, ...}}; when the
- * names do not fit in buf, the rays and totals only. */
-void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n)
-{
-    murk_counters t = counters_total(r);
-    size_t head = (size_t)snprintf(buf, n, "{\"rays\": %llu, \"total\": ", (unsigned long long)r->rays);
-    size_t k = json_counters(buf, n, head, &t);
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, ", \"media\": {");
-    for (int i = 0; i < r->nmedia && k < n; i++) {
-        k += (size_t)snprintf(buf + k, n - k, "%s\"", i ? ", " : "");
-        for (const char *p = slot_name(s, i); *p && k < n; p++) { /* escape " \ and control characters */
-            unsigned char ch = (unsigned char)*p;
-            k += ch < 0x20 ? (size_t)snprintf(buf + k, n - k, "\\u%04x", ch)
-                           : (size_t)snprintf(buf + k, n - k, ch == '"' || ch == '\\' ? "\\%c" : "%c", ch);
-        }
-        if (k < n)
-            k += (size_t)snprintf(buf + k, n - k, "\": ");
-        k = json_counters(buf, n, k, &r->media[i]);
-    }
-    if (k < n)
-        k += (size_t)snprintf(buf + k, n - k, "}}");
-    if (k >= n) { /* too long: the totals alone */
-        k = json_counters(buf, n, head, &t);
-        if (k < n)
-            snprintf(buf + k, n - k, "}");
-    }
-}
-
-/* The end-of-render summary's counters: rays, then one line per medium (and their sum when several). */
-void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r)
-{
-    fprintf(f, "counters: %llu rays traced", (unsigned long long)r->rays);
-    for (int i = 0; i <= r->nmedia; i++) {
-        if (i == r->nmedia && r->nmedia < 2)
-            break;
-        murk_counters t = i < r->nmedia ? r->media[i] : counters_total(r);
-        if (i < r->nmedia)
-            fprintf(f, "\n  medium '%s':", murk_cli_q(slot_name(s, i)));
-        else
-            fprintf(f, "\n  all media:");
-        for (int k = 0; k < MURK_NCOUNTERS; k++)
-            fprintf(f, " %llu %s%s", (unsigned long long)counter_get(&t, k), counter_names[k],
-                    k + 1 < MURK_NCOUNTERS ? "," : "");
-    }
-    fputc('\n', f);
 }
 
 /* ---- murk bench ---------------------------------------------------------------------------- */
@@ -606,20 +528,7 @@ static int make_reference(const bench *b, reference *r)
 
 /* ---- output ---- */
 
-static void json_str(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c < 0x20)
-            fprintf(f, "\\u%04x", c);
-        else if (c == '"' || c == '\\')
-            fprintf(f, "\\%c", c);
-        else
-            fputc(c, f);
-    }
-    fputc('"', f);
-}
+static void json_str(FILE *f, const char *s) { murk_html_json_string(f, s, strlen(s)); }
 
 static void csv_str(FILE *f, const char *s)
 {
@@ -875,6 +784,20 @@ static int run_charts(const bench *b)
     return 0;
 }
 
+/* DIR/report.html, once the bench's other files are written: rc (the chart script's status) or 1. */
+static int write_page(murk_html_page *page, const bench *b, int rc)
+{
+    char path[4200], err[8400];
+    snprintf(path, sizeof path, "%s/report.html", b->out);
+    murk_html_attach_bench(page, b->out);
+    if (murk_html_write(page, path, err, sizeof err) != 0) {
+        fprintf(stderr, "murk: %s\n", err);
+        return 1;
+    }
+    printf("comparison page: %s\n", murk_cli_q(path));
+    return rc;
+}
+
 static int run_bench(const bench *b, int argc, char **argv)
 {
     char err[2048], path[8192];
@@ -930,6 +853,15 @@ static int run_bench(const bench *b, int argc, char **argv)
         total_w += b->budgets[i] * b->repeat * b->nvariants;
     }
     size_t np = (size_t)r.w * (size_t)r.h;
+    snprintf(path, sizeof path, "murk bench: %s", b->scene);
+    murk_html_page *page = murk_html_new("bench", path, r.w, r.h, b->nvariants + 1, b->nvariants,
+                                         murk_limit(MURK_LIMIT_PAGE_BYTES));
+    if (b->reference)
+        snprintf(path, sizeof path, "given: %s", b->reference);
+    else
+        snprintf(path, sizeof path, "%d spp, the mean of %d chunks", REF_CHUNKS * ((b->ref_spp + REF_CHUNKS - 1) / REF_CHUNKS),
+                 REF_CHUNKS);
+    murk_html_image(page, b->nvariants, "reference", path, r.rgb, 1);
     float *pix = murk_xmalloc(np * sizeof(float));
     double *maps = calloc(np * (size_t)b->nvariants, sizeof(double));
     const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
@@ -966,19 +898,27 @@ static int run_bench(const bench *b, int argc, char **argv)
                 } else if (failed == 0) {
                     murk_metrics m;
                     murk_metrics_compute(res.rgb, r.rgb, r.var, r.w, (murk_crop){0, 0, r.w, r.h}, &m, pix);
-                    murk_counters t = counters_total(&res);
+                    murk_counters t = murk_counters_total(&res);
                     fprintf(csv, "%d,", v);
                     csv_str(csv, label);
                     fprintf(csv, ",%g,%d,%d,%.6f,%llu", b->budgets[bi], 1 + k, res.spp, res.seconds,
                             (unsigned long long)res.rays);
                     for (int c = 0; c < MURK_NCOUNTERS; c++)
-                        fprintf(csv, ",%llu", (unsigned long long)counter_get(&t, c));
+                        fprintf(csv, ",%llu", (unsigned long long)murk_counters_get(&t, c));
                     fprintf(csv, ",%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%llu,%.9g\n", m.mse, m.relmse, m.relmse_se,
                             m.relmse_raw, m.ref_noise, m.mare, (unsigned long long)(res.nonfinite + m.nonfinite),
                             res.max_sample);
-                    if (bi == big)
+                    if (bi == big) {
                         for (size_t p = 0; p < np; p++)
                             maps[(size_t)v * np + p] += isfinite(pix[p]) ? pix[p] / b->repeat : 0.0;
+                        murk_html_cost_add(page, v, res.seconds / b->repeat, (double)t.lookups / b->repeat,
+                                           m.relmse / b->repeat);
+                        char note[96]; /* the page shows the first seed's image: one render at this budget */
+                        snprintf(note, sizeof note, "seed 1 of %d, %g %s", b->repeat, b->budgets[bi],
+                                 b->time_mode ? "s" : "spp");
+                        if (k == 0)
+                            murk_html_image(page, v, label, note, res.rgb, 0);
+                    }
                     done++;
                 }
                 done_w += b->budgets[bi];
@@ -1028,6 +968,7 @@ static int run_bench(const bench *b, int argc, char **argv)
     for (int v = 0; v < b->nvariants && rc == 0; v++) {
         for (size_t p = 0; p < np; p++)
             pix[p] = (float)maps[(size_t)v * np + p];
+        murk_html_error_map(page, v, pix);
         snprintf(path, sizeof path, "%s/maps/variant%d.npy", b->out, v);
         npy_job nj = {pix, r.w, r.h};
         if (murk_write_atomic(path, npy_fill, &nj, err, sizeof err) != 0) {
@@ -1048,8 +989,12 @@ static int run_bench(const bench *b, int argc, char **argv)
     if (rc == 0)
         printf("%d renders (%d variants x %d budgets x %d seeds) in %.1f s: %s/bench.csv\n", total, b->nvariants,
                b->nbudgets, b->repeat, now() - t0, b->out);
+    int whole = rc == 0;
     if (rc == 0)
         rc = run_charts(b); /* and a signal after the last render is said there */
+    if (whole && rc <= 1 && !stopped(b))
+        rc = write_page(page, b, rc);
+    murk_html_free(page);
     return rc;
 }
 
@@ -1338,6 +1283,12 @@ int murk_cli_bench(int argc, char **argv)
         b.stop = murk_cli_catch_stop_signals(); /* a signal stops after the running render (run_bench) */
     if (rc == 0 && mkdirs(b.out) != 0) {
         fprintf(stderr, "murk: cannot create the output folder '%s': %s\n", murk_cli_q(b.out), strerror(errno));
+        rc = 1;
+    }
+    char page[4200], err[8400];
+    snprintf(page, sizeof page, "%s/report.html", b.out);
+    if (rc == 0 && murk_html_check_path(page, err, sizeof err) != 0) { /* before any render */
+        fprintf(stderr, "murk: %s; nothing was rendered\n", err);
         rc = 1;
     }
     if (rc == 0) {

@@ -1,25 +1,27 @@
 /* cli.c — the murk command line:
  *   murk render SCENE.yaml [-o out.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S]
  *   murk info SCENE.yaml [--set KEY.PATH=VALUE ...]   (info.c)
- *   murk plugins [NAME]
+ *   murk plugins [--markdown] [--all | NAME]   (plugins.c)
  *   murk compare A.exr B.exr [--diff d.png]
  *   murk grid OUT.vol [cloud options]     bakes the procedural cloud into a Mitsuba .vol grid
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "check.h"
-#include "cli.h"
-#include "density.h"
-#include "atomic.h"
-#include "image.h"
-#include "limit.h"
-#include "media.h"
-#include "mpi_job.h"
-#include "plugin_loader.h"
-#include "scene.h"
-#include "util.h"
+#include "check/check.h"
+#include "cli/cli.h"
+#include "image/image.h"
+#include "load/load.h"
+#include "media/density.h"
+#include "media/media.h"
+#include "plugin/plugin_loader.h"
+#include "render/counters.h"
+#include "render/mpi_job.h"
+#include "scene/scene.h"
+#include "util/atomic.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
-#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -28,21 +30,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static const char usage_text[] =
-    "usage:\n"
-    "  murk render SCENE.yaml [-o OUT.exr] [--spp N] [--threads N] [--set KEY.PATH=VALUE ...] [--time S] [--quiet]\n"
-    "              [--checkpoint FILE [--every S]] [--resume FILE] [--part I/N]\n"
-    "  mpirun -n N murk render ...          (one image over N processes)\n"
-    "  murk merge OUT.exr PART.exr...       (the parts of a --part I/N render into one image)\n"
-    "  murk info SCENE.yaml [--set KEY.PATH=VALUE ...]\n"
-    "  murk plugins [NAME]\n"
-    "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
-    "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
-    "  murk check [--seed S] [--quick] PLUGIN...\n"
-    "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
-    "  murk help [COMMAND]      (or murk COMMAND --help)\n"
-    "  murk --version\n";
 
 /* `murk help COMMAND` and `murk COMMAND --help`: what each subcommand does and takes. */
 static const struct command_help {
@@ -72,12 +59,16 @@ static const struct command_help {
      "the materials, the shapes (with their material, interior and exterior) and the plugins each uses with the\n"
      "file each was loaded from. Renders nothing.\n"},
     {"plugins",
-     "usage: murk plugins [NAME]\n"
+     "usage: murk plugins [--markdown] [--all | NAME]\n"
      "Without NAME: lists every plugin on the search path ($MURK_PLUGIN_PATH, then the build's or the installed\n"
      "plugin folder) with its kind, description and file. With NAME: that plugin's parameters, their types,\n"
-     "defaults and ranges (for a tracker also the keys every medium has).\n"},
+     "defaults, ranges and descriptions (for a tracker also the keys every medium has).\n"
+     "  --all        every plugin's parameters (a name found twice: the first, as a scene loads it)\n"
+     "  --markdown   markdown tables instead of text, without files or versions: the list, or with NAME or\n"
+     "               --all the parameters (what tools/plugin_docs.py writes into README.md and docs/plugins.md)\n"},
     {"compare",
      "usage: murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]]\n"
+     "                    [--html PAGE.html]\n"
      "Prints MSE, relMSE (mean (a-b)^2/(b^2+0.01)) with its standard error, the mean absolute relative error,\n"
      "a bias test (mean of a-b with its standard error and z-score) and, from the EXRs' render times and cost\n"
      "counters, the efficiency 1/(relMSE x seconds) and 1/(relMSE x density lookups).\n"
@@ -85,7 +76,9 @@ static const struct command_help {
      "  --json           one JSON object instead of text\n"
      "  --diff D.png     a heat map of |a-b| (white = the 99th percentile) and D_signed.png, the signed relative\n"
      "                   difference (a-b)/(|b|+0.01) on a fixed scale: blue -S, white 0, red +S\n"
-     "  --scale S        that scale (default 1)\n"},
+     "  --scale S        that scale (default 1)\n"
+     "  --html P.html    the interactive comparison page: both images (flip, split, zoom, exposure), the error\n"
+     "                   and efficiency maps and these figures, in one self-contained file\n"},
     {"bench", NULL}, /* bench.c prints its own (murk bench --help) */
     {"merge",
      "usage: murk merge OUT.exr PART.exr...\n"
@@ -142,31 +135,9 @@ static int wants_help(int argc, char **argv)
     return 0;
 }
 
-/* Untrusted text (arguments, names read from files) made printable for a message (murk_printable);
- * eight rotating buffers, so one message may quote several. */
-const char *murk_cli_q(const char *s)
-{
-    static char buf[8][1024];
-    static int k;
-    k = (k + 1) % 8;
-    return murk_printable(buf[k], sizeof buf[k], s);
-}
-
 #define q(s) murk_cli_q(s)
 #define cli_error(m) murk_cli_error(m)
 #define usage(m) murk_cli_usage(m)
-
-/* "murk: MESSAGE" for a message built from input (the scene's and loaders' errors are printable
- * already; plugin and image errors may quote a raw argument). */
-void murk_cli_error(const char *msg) { fprintf(stderr, "murk: %s\n", murk_cli_q(msg)); }
-
-int murk_cli_usage(const char *msg)
-{
-    if (msg)
-        fprintf(stderr, "murk: %s\n", msg);
-    fputs(usage_text, stderr);
-    return 2;
-}
 
 static int parse_int_arg(const char *opt, const char *v, long lo, long hi, long *out)
 {
@@ -215,49 +186,6 @@ static void human(double v, char *buf, size_t n)
         snprintf(buf, n, "%.2f k", v / 1e3);
     else
         snprintf(buf, n, "%.0f ", v);
-}
-
-/* SIGINT/SIGTERM/SIGHUP during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set
- * and murk goes on. render abandons the running pass, writes the image of the whole passes done
- * (murk:interrupted says so) and exits with 128 + the signal's number; bench (bench.c) stops after the
- * running render, keeps only whole renders' rows and exits the same way. A signal that was ignored when
- * murk started stays ignored: `nohup murk render ...` goes on rendering when its terminal hangs up, as
- * nohup promises, and a job a non-interactive shell started in the background keeps ignoring SIGINT. */
-static volatile sig_atomic_t render_stop, render_signal;
-
-static void on_stop_signal(int sig)
-{
-    render_signal = sig;
-    render_stop = 1;
-}
-
-volatile sig_atomic_t *murk_cli_catch_stop_signals(void)
-{
-    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
-    for (size_t i = 0; i < sizeof sigs / sizeof sigs[0]; i++) {
-        struct sigaction sa, old;
-        if (sigaction(sigs[i], NULL, &old) == 0 && old.sa_handler == SIG_IGN)
-            continue;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_stop_signal;
-        sigemptyset(&sa.sa_mask);
-        sigaction(sigs[i], &sa, NULL);
-    }
-    return &render_stop;
-}
-
-int murk_cli_stop_status(void) { return 128 + (render_signal ? (int)render_signal : SIGINT); }
-
-const char *murk_cli_stop_name(void)
-{
-    return render_signal == SIGTERM ? "SIGTERM" : render_signal == SIGHUP ? "SIGHUP" : "SIGINT";
-}
-
-/* Under mpirun stderr is a pipe to the launcher whatever the terminal: MURK_PROGRESS=1 asks for the bar. */
-int murk_cli_progress(void)
-{
-    const char *e = getenv("MURK_PROGRESS");
-    return isatty(STDERR_FILENO) || (e && !strcmp(e, "1"));
 }
 
 /* ---- render under MPI -------------------------------------------------------------------------
@@ -385,7 +313,7 @@ static int parse_part(const char *v, int *part, int *parts)
 
 static int render_main(int argc, char **argv)
 {
-    murk_cli_catch_stop_signals();
+    volatile sig_atomic_t *stop = murk_cli_catch_stop_signals();
     const char *scene_path = NULL, *out = NULL;
     const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
     size_t nsets = 0;
@@ -518,7 +446,7 @@ static int render_main(int argc, char **argv)
         free(sets);
         return 1;
     }
-    opts.stop = &render_stop;
+    opts.stop = stop;
     murk_render_result res;
     if (murk_render_err(s, &opts, &res, err, sizeof err) != 0) {
         if (err[0])
@@ -552,7 +480,7 @@ static int render_main(int argc, char **argv)
     snprintf(secs, sizeof secs, "%.3f", res.seconds);
     snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
     static char counters[16384];
-    murk_cli_counters_json(s, &res, counters, sizeof counters);
+    murk_counters_json(s, &res, counters, sizeof counters);
     murk_kv meta[] = {
         {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
@@ -587,7 +515,7 @@ static int render_main(int argc, char **argv)
         cli_error(err);
         rc = 1;
     }
-    if (res.interrupted || render_stop) /* also when the signal came during the writes and cut them short */
+    if (res.interrupted || *stop) /* also when the signal came during the writes and cut them short */
         rc = murk_cli_stop_status();
     if (rc == 0 && !quiet) {
         char sps[32], rps[32];
@@ -595,7 +523,7 @@ static int render_main(int argc, char **argv)
         human((double)res.rays / res.seconds, rps, sizeof rps);
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
                res.seconds, sps, rps);
-        murk_cli_counters_print(stdout, s, &res);
+        murk_counters_print(stdout, s, &res);
         murk_cli_memory_print(stdout, s, 0);
     }
     murk_warn_summary();
@@ -607,130 +535,6 @@ static int render_main(int argc, char **argv)
     murk_scene_free(s);
     free(outbuf);
     free(sets);
-    return rc;
-}
-
-/* ---- plugins ------------------------------------------------------------------------------- */
-
-static const char *type_name(uint32_t t)
-{
-    static const char *const names[] = {"?", "float", "int", "bool", "rgb", "string", "enum"};
-    return t <= MURK_PARAM_ENUM ? names[t] : "?";
-}
-
-static void print_params(const murk_param *ps, uint32_t n)
-{
-    for (uint32_t i = 0; i < n; i++) {
-        const murk_param *q = &ps[i];
-        char def[128], range[96] = "";
-        switch (q->type) {
-        case MURK_PARAM_RGB:
-            snprintf(def, sizeof def, "[%g, %g, %g]", q->def[0], q->def[1], q->def[2]);
-            break;
-        case MURK_PARAM_BOOL:
-            snprintf(def, sizeof def, "%s", q->def[0] != 0 ? "true" : "false");
-            break;
-        case MURK_PARAM_STRING:
-        case MURK_PARAM_ENUM:
-            snprintf(def, sizeof def, "%s", q->def_str ? q->def_str : "");
-            break;
-        default:
-            snprintf(def, sizeof def, "%g", q->def[0]);
-        }
-        if (q->type == MURK_PARAM_ENUM)
-            snprintf(range, sizeof range, "one of %s", q->choices);
-        else if (q->type != MURK_PARAM_STRING && q->type != MURK_PARAM_BOOL)
-            snprintf(range, sizeof range, "[%g, %g]", q->min, q->max);
-        printf("    %-19s %-6s default %-18s %-22s %s%s%s\n", q->name, type_name(q->type), def, range, q->doc,
-               (q->flags & MURK_PARAM_TEXTURABLE) ? " (texturable)" : "", (q->flags & MURK_PARAM_REQUIRED) ? " (required)" : "");
-    }
-}
-
-static void describe(const murk_plugin *p)
-{
-    const murk_plugin_desc *d = p->desc;
-    printf("%s %s — %s\n  file: %s (version %s, ABI %u.%u)\n", murk_kind_name((int)d->kind), d->name, d->description,
-           p->path, p->version ? p->version : "none", p->abi.major, p->abi.minor);
-    if (d->kind == MURK_KIND_MEDIUM) {
-        printf("  medium keys (read by the core, for every tracker):\n");
-        printf("    %-19s %-6s %s\n", "density", "map", "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }");
-        print_params(murk_medium_core_params, MURK_MEDIUM_NCORE);
-        printf("    %-19s %-6s %s\n", "transmittance", "name",
-               "shadow-ray estimator: NAME or { type: NAME, ... } (default: the tracker's own)");
-    }
-    if (d->kind == MURK_KIND_TRANSMITTANCE)
-        printf("  a medium selects it with `transmittance: %s` (or { type: %s, ... }) beside its tracker\n", d->name, d->name);
-    if (!d->nparams) {
-        printf("  no parameters of its own\n");
-        return;
-    }
-    printf("  parameters:\n");
-    print_params(d->params, d->nparams);
-}
-
-static int cmd_plugins(int argc, char **argv)
-{
-    murk_registry reg;
-    murk_registry_init(&reg);
-    char err[1024];
-    int rc = 0;
-    if (argc > 1 || (argc == 1 && argv[0][0] == '-')) {
-        murk_registry_free(&reg);
-        if (argc == 1)
-            fprintf(stderr, "murk: unknown plugins option '%s'\n", q(argv[0]));
-        return usage(argc > 1 ? "plugins takes at most one name" : NULL);
-    }
-    if (argc == 1) {
-        const murk_plugin *p = murk_registry_load(&reg, 0, argv[0], err, sizeof err);
-        if (p)
-            describe(p);
-        else {
-            cli_error(err);
-            rc = 1;
-        }
-        murk_registry_free(&reg);
-        return rc;
-    }
-    for (size_t i = 0; i < reg.ndirs; i++) {
-        DIR *d = opendir(reg.dirs[i]);
-        if (!d)
-            continue;
-        struct dirent *e;
-        char **names = NULL;
-        size_t nn = 0;
-        while ((e = readdir(d))) {
-            size_t l = strlen(e->d_name);
-            if (l > 3 && strcmp(e->d_name + l - 3, ".so") == 0) {
-                names = murk_xrealloc(names, (nn + 1) * sizeof *names);
-                names[nn++] = murk_strdup(e->d_name);
-            }
-        }
-        closedir(d);
-        for (size_t a = 0; a < nn; a++) /* sorted listing */
-            for (size_t b = a + 1; b < nn; b++)
-                if (strcmp(names[b], names[a]) < 0) {
-                    char *t = names[a];
-                    names[a] = names[b];
-                    names[b] = t;
-                }
-        for (size_t k = 0; k < nn; k++) {
-            size_t n = strlen(reg.dirs[i]) + strlen(names[k]) + 2;
-            char *path = murk_xmalloc(n);
-            snprintf(path, n, "%s/%s", reg.dirs[i], names[k]);
-            murk_plugin p;
-            if (murk_plugin_open(path, 0, &p, err, sizeof err) == 0) {
-                printf("%-10s %-16s %-58s %s\n", murk_kind_name((int)p.desc->kind), p.desc->name, p.desc->description,
-                       path);
-                murk_plugin_close(&p);
-            } else {
-                printf("%-10s %-16s %s\n", "(broken)", names[k], err);
-            }
-            free(path);
-            free(names[k]);
-        }
-        free(names);
-    }
-    murk_registry_free(&reg);
     return rc;
 }
 
@@ -863,7 +667,7 @@ int murk_cli_main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
-        fputs(usage_text, stdout);
+        fputs(murk_cli_usage_text, stdout);
         return 0;
     }
     int known = 0;
@@ -878,7 +682,7 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "info"))
         return murk_cli_info(argc - 2, argv + 2);
     if (!strcmp(cmd, "plugins"))
-        return cmd_plugins(argc - 2, argv + 2);
+        return murk_cli_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
         return murk_cli_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench"))

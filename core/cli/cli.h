@@ -14,7 +14,8 @@ int murk_cli_info(int argc, char **argv);
  * medium and material is used (murk_scene_check_unused). NULL after printing the one-line error. */
 struct murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets);
 
-/* Shared by the subcommands' files. */
+/* Shared by the subcommands' files (common.c, which reaches none of them). */
+extern const char murk_cli_usage_text[]; /* every subcommand's synopsis: `murk --help` */
 const char *murk_cli_q(const char *s); /* untrusted text made printable (eight rotating buffers) */
 void murk_cli_error(const char *msg);  /* "murk: MESSAGE" on stderr */
 int murk_cli_usage(const char *msg);   /* the message and the usage text on stderr; returns 2 */
@@ -29,14 +30,10 @@ const char *murk_cli_stop_name(void);
 int murk_cli_progress(void);
 
 int murk_cli_compare(int argc, char **argv); /* compare.c */
+int murk_cli_plugins(int argc, char **argv); /* plugins.c */
 int murk_cli_bench(int argc, char **argv);   /* bench.c */
 
-/* The cost counters (murk/counters.h) of a render as JSON for the EXR's murk:counters, and as the
- * end-of-render summary's lines (bench.c). */
 #include <stdio.h>
-#include "murk/murk.h"
-void murk_cli_counters_json(const murk_scene *s, const murk_render_result *r, char *buf, size_t n);
-void murk_cli_counters_print(FILE *f, const murk_scene *s, const murk_render_result *r);
 /* What the scene holds in memory (info.c): every grid, mesh, texture and Embree's scene with its bytes when
  * detail, else one line of totals per kind; then the process's peak resident memory. */
 void murk_cli_memory_print(FILE *f, const struct murk_scene *s, int detail);

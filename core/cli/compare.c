@@ -1,13 +1,16 @@
-/* compare.c — `murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png] [--scale S]`:
+/* compare.c — `murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png] [--scale S]
+ * [--html PAGE.html]`:
  * the error figures of one image against a reference (metrics.c, the same code `murk bench` uses), a
  * bias test (mean difference, its standard error and z-score), the efficiency from the render time and
  * cost counters the EXR records, and two pictures of the difference: a heat map of |a - r| scaled to its
- * 99th percentile, and beside it a signed map on a fixed scale. Part of the murk executable. */
-#include "atomic.h"
-#include "cli.h"
-#include "image.h"
-#include "metrics.h"
-#include "util.h"
+ * 99th percentile, and beside it a signed map on a fixed scale; --html, the interactive comparison page
+ * (cli/report_html.h). Part of the murk executable. */
+#include "cli/cli.h"
+#include "cli/metrics.h"
+#include "cli/report_html.h"
+#include "image/image.h"
+#include "util/atomic.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -131,7 +134,7 @@ static int write_maps(const char *diff, const float *A, const float *B, int w, m
 
 int murk_cli_compare(int argc, char **argv)
 {
-    const char *a = NULL, *b = NULL, *diff = NULL;
+    const char *a = NULL, *b = NULL, *diff = NULL, *html = NULL;
     int json = 0, cropped = 0;
     double scale = 1.0;
     murk_crop crop = {0, 0, 0, 0};
@@ -140,6 +143,10 @@ int murk_cli_compare(int argc, char **argv)
             if (i + 1 >= argc)
                 return usage("--diff needs a .png file name");
             diff = argv[++i];
+        } else if (!strcmp(argv[i], "--html")) {
+            if (i + 1 >= argc)
+                return usage("--html needs an .html file name");
+            html = argv[++i];
         } else if (!strcmp(argv[i], "--crop")) {
             if (i + 1 >= argc || parse_crop(argv[i + 1], &crop))
                 return usage("--crop needs X,Y,W,H (whole numbers, W and H above 0)");
@@ -168,6 +175,10 @@ int murk_cli_compare(int argc, char **argv)
         return usage("compare needs two EXR files: TEST REFERENCE");
     murk_image A = {0}, B = {0};
     char err[1024];
+    if (html && murk_html_check_path(html, err, sizeof err) != 0) { /* before any work */
+        cli_error(err);
+        return 1;
+    }
     if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
         cli_error(err);
         murk_image_free(&A);
@@ -190,18 +201,25 @@ int murk_cli_compare(int argc, char **argv)
         double t = render_seconds(&A), look = render_lookups(&A);
         double eff_t = t > 0 && m.relmse > 0 ? 1.0 / (m.relmse * t) : -1;
         double eff_l = look > 0 && m.relmse > 0 ? 1.0 / (m.relmse * look) : -1;
-        if (json) {
-            printf("{\"test\": \"%s\", \"reference\": \"%s\", \"crop\": [%d, %d, %d, %d], \"n\": %zu, "
+        char *js = NULL; /* the --json object, also the page's figures */
+        size_t jl = 0;
+        FILE *jf = json || html ? open_memstream(&js, &jl) : NULL;
+        if (jf) {
+            fprintf(jf, "{\"test\": \"%s\", \"reference\": \"%s\", \"crop\": [%d, %d, %d, %d], \"n\": %zu, "
                    "\"nonfinite\": %zu, \"mse\": %.9g, \"relmse\": %.9g, \"relmse_se\": %.9g, \"mare\": %.9g, "
                    "\"diff\": [%.9g, %.9g, %.9g, %.9g], \"diff_se\": [%.9g, %.9g, %.9g, %.9g], \"z\": %.6g",
                    murk_cli_q(a), murk_cli_q(b), crop.x, crop.y, crop.w, crop.h, m.n, m.nonfinite, m.mse, m.relmse,
                    m.relmse_se, m.mare, m.diff[0], m.diff[1], m.diff[2], m.diff[3], m.diff_se[0], m.diff_se[1],
                    m.diff_se[2], m.diff_se[3], z);
             if (t > 0)
-                printf(", \"seconds\": %.6g, \"efficiency_time\": %.9g", t, eff_t);
+                fprintf(jf, ", \"seconds\": %.6g, \"efficiency_time\": %.9g", t, eff_t);
             if (look > 0)
-                printf(", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", look, eff_l);
-            printf("}\n");
+                fprintf(jf, ", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", look, eff_l);
+            fprintf(jf, "}\n");
+            fclose(jf);
+        }
+        if (json) {
+            fputs(js ? js : "", stdout);
         } else {
             printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
                    m.mse, m.relmse, m.mare, murk_cli_q(a), murk_cli_q(b));
@@ -220,6 +238,15 @@ int murk_cli_compare(int argc, char **argv)
             fprintf(stderr, "murk: warning: %zu non-finite values skipped\n", m.nonfinite);
         if (diff)
             rc = write_maps(diff, A.rgb, B.rgb, A.w, crop, scale, json);
+        if (html && rc == 0) {
+            if (!js || murk_html_compare(html, a, b, A.rgb, B.rgb, A.w, &crop, js, t, look, err, sizeof err) != 0) {
+                cli_error(js ? err : "out of memory");
+                rc = 1;
+            } else if (!json) {
+                printf("comparison page: %s\n", murk_cli_q(html));
+            }
+        }
+        free(js);
     }
     murk_image_free(&A);
     murk_image_free(&B);

@@ -2,11 +2,12 @@
  * checks, same messages) and lists what it holds: render settings, camera, integrator, media (tracker,
  * transmittance estimator, density, majorant grid), materials, shapes (material, interior, exterior) and
  * every plugin loaded, with its file. Renders nothing. Part of the murk executable, not of libmurk. */
-#include "cli.h"
-#include "density.h"
-#include "media.h"
-#include "scene.h"
-#include "util.h"
+#include "cli/cli.h"
+#include "load/load.h"
+#include "media/density.h"
+#include "media/media.h"
+#include "scene/scene.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,6 +1,6 @@
 /* main.c — the murk command: argument parsing and subcommands are in cli.c, the renderer in libmurk. */
-#include "cli.h"
-#include "plugin_loader.h"
+#include "cli/cli.h"
+#include "plugin/plugin_loader.h"
 
 int main(int argc, char **argv)
 {

@@ -12,11 +12,11 @@
  * of murk:counters) summed over the parts — so its counters are the single-process render's — the
  * largest murk:max_sample, and
  * its PNG preview is written beside it as `render` does: both files or neither. */
-#include "cli.h"
-#include "atomic.h"
-#include "image.h"
+#include "cli/cli.h"
+#include "image/image.h"
+#include "util/atomic.h"
 #include "murk/murk.h"
-#include "util.h"
+#include "util/util.h"
 
 #include <stdio.h>
 #include <stdlib.h>

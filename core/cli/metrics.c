@@ -4,7 +4,7 @@
  * dominating). With independent renders E[(a - r)^2] = bias^2 + Var a + Var r: the reference's noise
  * adds Var r, which the corrected figure subtracts with an unbiased estimate v of it. The standard
  * errors treat pixels as independent samples — they are: murk draws one random stream per pixel. */
-#include "metrics.h"
+#include "cli/metrics.h"
 
 #include <math.h>
 

@@ -12,10 +12,10 @@
  * errno). Writes do not call back into the library from that callback: OpenEXRCore 3.1 holds a
  * non-recursive lock on write contexts while reporting, so the callback stays silent and the
  * message names the failing step plus the library's text for the result code. */
-#include "image.h"
-#include "atomic.h"
-#include "error.h"
-#include "util.h"
+#include "image/image.h"
+#include "util/atomic.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <stdint.h>

@@ -1,10 +1,10 @@
 /* image.c — what the EXR (exr.c) and PNG (png.c) readers and writers share: size checks, opening an
  * input, the image returned by the readers and its string attributes. */
-#include "image.h"
-#include "error.h"
-#include "file.h"
-#include "limit.h"
-#include "util.h"
+#include "image/image.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/limit.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -5,10 +5,10 @@
  * 8/16-bit grey, grey+alpha, RGB, RGBA or palette image to 8-bit RGB, then maps it to linear floats
  * (the exact sRGB EOTF, or v/255). libpng errors longjmp back into small functions whose caller owns
  * every resource, so nothing leaks. */
-#include "image.h"
-#include "atomic.h"
-#include "error.h"
-#include "util.h"
+#include "image/image.h"
+#include "util/atomic.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <setjmp.h>

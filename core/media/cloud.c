@@ -1,7 +1,7 @@
 /* cloud.c — the procedural cloud: fBm gradient noise shaped into a ball, baked into a grid field so
  * that it interpolates and bounds exactly like a file grid (see murk_field_cloud in density.h). */
-#include "field_impl.h"
-#include "util.h"
+#include "media/field_impl.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>

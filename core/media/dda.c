@@ -1,6 +1,6 @@
 /* dda.c — the 3-D DDA walk through a bound grid: consecutive segments that exactly tile a ray's
  * parameter range, each with its cell's majorant and minorant (see density.h for the contract). */
-#include "density.h"
+#include "media/density.h"
 
 #include <math.h>
 #include <string.h>

@@ -38,7 +38,7 @@
 #ifndef MURK_DENSITY_H
 #define MURK_DENSITY_H
 
-#include "limit.h"
+#include "util/limit.h"
 #include <stddef.h>
 #include <stdint.h>
 

@@ -2,9 +2,9 @@
  * memory, evaluated trilinearly, and queried. See density.h for the conventions (values at cell centres,
  * trilinear, clamp, 0 outside). The grid sources are in vol.c, nanovdb.c and cloud.c; the majorant grid
  * over a field in majorant.c, its DDA walk in dda.c. */
-#include "field_impl.h"
-#include "error.h"
-#include "util.h"
+#include "media/field_impl.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>

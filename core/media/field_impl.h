@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "density.h"
+#include "media/density.h"
 
 enum { FIELD_CONSTANT, FIELD_GRID, FIELD_SPARSE };
 

@@ -2,7 +2,7 @@
  * (see density.h for the guarantee). Trackers walk it with the DDA in dda.c. A grid whose map is not
  * axis-aligned (field_impl.h, `affine`) gets its bound grid over its local box; the walk transforms
  * the ray (media.c). */
-#include "field_impl.h"
+#include "media/field_impl.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -18,19 +18,17 @@
  *       transmittance: ratio        # shadow rays' estimator plugin, or { type: NAME, its keys ... };
  *                                   # none: the tracker's own transmittance() (murk/transmittance.h)
  *       ...                         # the tracker's own parameters */
-#include "media.h"
-#include "density.h"
+#include "media/media.h"
+#include "media/density.h"
 #include "media/source.h"
-#include "host.h"
-#include "limit.h"
-#include "params.h"
-#include "scene.h"
-#include "util.h"
-#include "yread.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
-#include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,7 +37,7 @@ struct murk_density {
     murk_field *field;
     murk_bound_grid grid;
     float factor;
-    unsigned slot;   /* its medium's cost counters (host.h) */
+    unsigned slot;   /* its medium's cost counters (runtime.h) */
     int transformed; /* the field's map rotates, shears or mirrors (murk_field_local_ray) */
 };
 
@@ -54,7 +52,7 @@ MURK_API void murk_density_parts(const murk_density *d, const murk_field **field
 typedef struct walk {
     murk_dda dda;
     float factor;
-    murk_counters *count; /* this thread's block for the medium (host.h), taken once per walk */
+    murk_counters *count; /* this thread's block for the medium (runtime.h), taken once per walk */
 } walk;
 
 _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk too small for the DDA state");
@@ -93,44 +91,6 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     if (dmin)
         *dmin = mn;
     return r;
-}
-
-static pthread_mutex_t warn_lock = PTHREAD_MUTEX_INITIALIZER;
-static struct { char *msg; unsigned long count; } warned[128];
-static int nwarned;
-
-void murk_warn_once(const char *fmt, ...)
-{
-    char buf[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    pthread_mutex_lock(&warn_lock);
-    int i = 0;
-    while (i < nwarned && strcmp(warned[i].msg, buf) != 0)
-        i++;
-    if (i < nwarned) {
-        warned[i].count++;
-    } else if (nwarned < (int)(sizeof warned / sizeof warned[0])) {
-        warned[nwarned].msg = murk_strdup(buf);
-        warned[nwarned].count = 1;
-        nwarned++;
-        murk_log(MURK_LOG_WARN, "%s", buf);
-    }
-    pthread_mutex_unlock(&warn_lock);
-}
-
-MURK_API void murk_warn_summary(void)
-{
-    pthread_mutex_lock(&warn_lock);
-    for (int i = 0; i < nwarned; i++) {
-        if (warned[i].count > 1)
-            murk_log(MURK_LOG_WARN, "(%lu times in all) %s", warned[i].count, warned[i].msg);
-        free(warned[i].msg);
-    }
-    nwarned = 0;
-    pthread_mutex_unlock(&warn_lock);
 }
 
 float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi)
@@ -198,8 +158,8 @@ static size_t skip_keys(const murk_plugin_desc *d, const char **out, size_t cap)
 
 /* `transmittance: NAME` or `transmittance: { type: NAME, key: value, ... }`: the medium's estimator plugin,
  * its parameters checked against its schema like a tracker's, created on the medium's data. */
-static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, murk_named_medium *nm, char *err,
-                          size_t errlen)
+static int load_estimator(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *n,
+                          murk_named_medium *nm, char *err, size_t errlen)
 {
     static const char *const skip[] = {"type"};
     const murk_ynode *t = n->kind == MURK_Y_MAP ? murk_ymap_get(n, "type") : n;
@@ -210,7 +170,7 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
     snprintf(block, sizeof block, "medium '%s': transmittance", name);
     snprintf(who, sizeof who, "medium '%s' transmittance (%s)", name, t->str);
     const murk_plugin *p;
-    if (murk_scene_instantiate(s, MURK_KIND_TRANSMITTANCE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP,
+    if (murk_scene_instantiate(s, host, MURK_KIND_TRANSMITTANCE, t, t->str, n, block, who, skip, n->kind == MURK_Y_MAP,
                                &nm->data, &p, &nm->m.tr_self, err, errlen))
         return -1;
     nm->m.tr_vt = p->desc->vtable;
@@ -218,8 +178,8 @@ static int load_estimator(murk_scene *s, const char *name, const murk_ynode *n, 
     return 0;
 }
 
-static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, murk_named_medium *nm, char *err,
-                       size_t errlen)
+static int load_medium(murk_scene *s, const murk_host *host, const char *name, const murk_ynode *m,
+                       murk_named_medium *nm, char *err, size_t errlen)
 {
     char block[256], who[256];
     snprintf(block, sizeof block, "medium '%s'", name);
@@ -243,7 +203,7 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     const murk_plugin_desc core_desc = {sizeof(murk_plugin_desc), MURK_KIND_MEDIUM, tp->desc->name, "the core's keys",
                                         murk_medium_core_params, MURK_MEDIUM_NCORE, NULL, NULL};
     murk_value core[MURK_MEDIUM_NCORE];
-    if (murk_scene_read_plugin_params(s, &core_desc, m, who, skip, nskip, core, err, errlen))
+    if (murk_scene_read_plugin_params(s, &core_desc, m, who, skip, nskip, 0, core, err, errlen))
         return -1;
     murk_medium_data *md = &nm->data;
     md->size = sizeof *md;
@@ -305,15 +265,15 @@ static int load_medium(murk_scene *s, const char *name, const murk_ynode *m, mur
     for (size_t i = 0; i < MURK_MEDIUM_NCORE; i++)
         skip[nskip++] = murk_medium_core_params[i].name;
     const murk_plugin *p;
-    if (murk_scene_instantiate(s, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self, err,
-                               errlen))
+    if (murk_scene_instantiate(s, host, MURK_KIND_MEDIUM, t, t->str, m, block, who, skip, nskip, md, &p, &nm->m.self,
+                               err, errlen))
         return -1;
     nm->m.vt = p->desc->vtable;
     nm->m.name = nm->name;
     nm->m.data = md;
     nm->plugin = p;
     const murk_ynode *tn = murk_ymap_get(m, "transmittance");
-    return tn ? load_estimator(s, name, tn, nm, err, errlen) : 0;
+    return tn ? load_estimator(s, host, name, tn, nm, err, errlen) : 0;
 }
 
 static void medium_free(murk_named_medium *nm)
@@ -330,19 +290,19 @@ static void medium_free(murk_named_medium *nm)
     free(nm->name);
 }
 
-int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+int murk_media_load(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     if (n->kind != MURK_Y_MAP)
         return murk_yerr(err, errlen, n, "media must be a map of NAME: { type: TRACKER, ... }");
     s->media = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->media);
     for (size_t i = 0; i < n->n; i++) {
         murk_named_medium *nm = &s->media[i];
-        if (load_medium(s, n->keys[i], n->items[i], nm, err, errlen) != 0) {
+        if (load_medium(s, host, n->keys[i], n->items[i], nm, err, errlen) != 0) {
             medium_free(nm);
             memset(nm, 0, sizeof *nm);
             return -1;
         }
-        murk_host_count_medium(&nm->m, nm->density->slot);
+        murk_media_count_medium(&nm->m, nm->density->slot);
         s->nmedia++;
     }
     return 0;

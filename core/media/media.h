@@ -5,9 +5,11 @@
 
 #include "murk/medium.h"
 #include "murk/murk.h"
-#include "yamldoc.h"
+#include "yaml/yamldoc.h"
 
-int murk_media_load(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+/* The `media:` block n: each medium's data, density and tracker (and estimator) plugins, created with the
+ * services table host. */
+int murk_media_load(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen);
 /* Refuses a medium whose optical depth (largest extinction x max density x majorant_factor x extent:
  * its density box, or the scene's box [scene_lo, scene_hi] for a constant density) exceeds
  * MURK_MAX_OPTICAL_DEPTH (limit.h): a located error at the medium's scale/sigma key. */
@@ -21,6 +23,10 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
 extern const char *const murk_medium_special_keys[2];
 void murk_media_free(murk_scene *s);
+/* Wraps a scene's medium (its tracker and, if any, its transmittance estimator) so that every free
+ * flight that scatters and every transmittance estimate is counted in the medium's slot (counted.c).
+ * The wrapped destroy() frees the wrapper too. */
+void murk_media_count_medium(murk_medium *m, unsigned slot);
 /* What a medium's density is made of, for `murk info`: its field, majorant grid and majorant_factor. */
 struct murk_field;
 struct murk_bound_grid;
@@ -30,11 +36,8 @@ void murk_density_parts(const murk_density *d, const struct murk_field **field, 
 float murk_media_density(const murk_density *d, murk_vec3 p);
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
-/* The calling thread's cost counters for d's medium (host.h): the host's counters() service. */
+/* The calling thread's cost counters for d's medium (runtime.h): the host's counters() service. */
 murk_counters *murk_media_counters(const murk_density *d);
-void murk_warn_once(const char *fmt, ...) MURK_PRINTF(1, 2);
-/* Prints how often each once-only warning repeated, and forgets them. */
-void murk_warn_summary(void);
 float murk_phase_hg_eval(float g, murk_vec3 wo, murk_vec3 wi);
 murk_vec3 murk_phase_hg_sample(float g, murk_vec3 wo, const float u[2], float *pdf);
 

@@ -8,8 +8,8 @@
  * Each grid buffer is read with PNanoVDB (the C port of NanoVDB), bounds-checked, so a corrupt file
  * yields zeros or an error rather than a wild read. */
 #include "media/field_impl.h"
-#include "error.h"
-#include "file.h"
+#include "util/error.h"
+#include "util/file.h"
 
 #include <math.h>
 #include <stdint.h>

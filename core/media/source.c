@@ -1,7 +1,7 @@
 /* source.c — a scalar field from a scene block (source.h has the syntax): the medium's density, and any
  * other field a medium reads the same way. */
 #include "media/source.h"
-#include "scene/yread.h"
+#include "yaml/yread.h"
 #include "util/limit.h"
 #include "util/util.h"
 

@@ -14,7 +14,7 @@
 #include <stddef.h>
 
 #include "media/density.h"
-#include "scene/yamldoc.h"
+#include "yaml/yamldoc.h"
 
 /* The field the block n describes; `what` names the block in messages ("density", "temperature", ...).
  * NULL with a located error ("scene.yaml:12:7: density: cloud.vdb: no grid 'dens'; the file has

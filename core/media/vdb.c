@@ -5,6 +5,7 @@
 #include "util/error.h"
 #include "util/file.h"
 #include "util/limit.h"
+#include "util/runtime.h"
 #include "util/util.h"
 
 #include <stdio.h>

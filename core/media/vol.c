@@ -2,11 +2,11 @@
  *
  * Format (little-endian): 'V' 'O' 'L' 3 | int32 encoding (1 = float32) | int32 xres, yres, zres |
  * int32 channels | float32 xmin ymin zmin xmax ymax zmax | float32 data[((z*yres + y)*xres + x)*channels + c]. */
-#include "field_impl.h"
-#include "atomic.h"
-#include "error.h"
-#include "file.h"
-#include "util.h"
+#include "media/field_impl.h"
+#include "util/atomic.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <stdio.h>

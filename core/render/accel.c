@@ -1,8 +1,9 @@
 /* accel.c — the Embree 3 scene: triangle geometry for quads, boxes and meshes; Embree's analytic
  * point-spheres for spheres. Geometry ids equal shape indices. */
-#include "accel.h"
-#include "error.h"
-#include "util.h"
+#include "render/accel.h"
+#include "util/error.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <stdio.h>
 #include <stdlib.h>

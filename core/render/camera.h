@@ -5,7 +5,7 @@
 #ifndef MURK_CAMERA_H
 #define MURK_CAMERA_H
 
-#include "scene.h"
+#include "scene/scene.h"
 
 #include <math.h>
 

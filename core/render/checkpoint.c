@@ -1,9 +1,9 @@
 /* checkpoint.c — saving and loading a render's accumulated state (see checkpoint.h). */
-#include "checkpoint.h"
-#include "atomic.h"
-#include "error.h"
-#include "file.h"
-#include "util.h"
+#include "render/checkpoint.h"
+#include "util/atomic.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/util.h"
 
 #include <stdio.h>
 #include <stdlib.h>

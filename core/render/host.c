@@ -1,12 +1,14 @@
 /* host.c — the services table plugins receive: memory, logging, textures, and the scene queries
  * integrators use (closest hit, occlusion, light sampling and its pdf, background). Rays and the cost
  * counters (murk/counters.h) are counted per thread and summed by render.c when a thread's work ends. */
-#include "host.h"
-#include "accel.h"
-#include "media.h"
-#include "scene.h"
-#include "texture.h"
-#include "util.h"
+#include "render/host.h"
+#include "media/media.h"
+#include "render/accel.h"
+#include "render/lights.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -17,7 +19,7 @@
 #include <emmintrin.h>
 #endif
 
-/* initial-exec, like murk_thread_counters (host.h): a fixed offset from the thread pointer, where the
+/* initial-exec, like murk_thread_counters (runtime.h): a fixed offset from the thread pointer, where the
  * default model for a shared library's TLS calls __tls_get_addr on every access (every ray, here). */
 #if defined(__GNUC__)
 #define MURK_TLS_IE __attribute__((tls_model("initial-exec")))
@@ -25,7 +27,6 @@
 #define MURK_TLS_IE
 #endif
 static _Thread_local uint64_t thread_rays MURK_TLS_IE;
-_Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
 
 /* The rays being recorded (murk_host_record_rays), or NULL: one predictable branch per ray otherwise. */
 static murk_ray_record *ray_record;
@@ -46,83 +47,7 @@ uint64_t murk_host_thread_rays(void) { return thread_rays; }
 void murk_host_thread_reset(void)
 {
     thread_rays = 0;
-    memset(murk_thread_counters, 0, sizeof murk_thread_counters);
-}
-
-void murk_host_thread_counters_add(murk_counters *sum, size_t n)
-{
-    for (size_t i = 0; i < n && i < MURK_COUNTER_SLOTS; i++) {
-        const murk_counters *c = &murk_thread_counters[i];
-        sum[i].lookups += c->lookups;
-        sum[i].cells += c->cells;
-        sum[i].collisions += c->collisions;
-        sum[i].scatters += c->scatters;
-        sum[i].shadow += c->shadow;
-    }
-}
-
-/* ---- counting wrappers around a medium's tracker and estimator ------------------------------ */
-
-typedef struct counted {
-    const murk_medium_vt *vt; /* the tracker's own */
-    void *self;
-    const murk_transmittance_vt *tr_vt; /* the estimator's own, or NULL */
-    void *tr_self;
-    unsigned slot;
-} counted;
-
-static void counted_destroy(void *self)
-{
-    counted *c = self;
-    if (c->self)
-        c->vt->destroy(c->self);
-    if (c->tr_self)
-        c->tr_vt->destroy(c->tr_self);
-    free(c);
-}
-
-static void counted_sample(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng,
-                           murk_medium_event *ev)
-{
-    const counted *c = self;
-    c->vt->sample(c->self, ray, ctx, rng, ev);
-    murk_thread_counters[c->slot].scatters += ev->scattered != 0;
-}
-
-static murk_rgb counted_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
-{
-    const counted *c = self;
-    murk_thread_counters[c->slot].shadow++;
-    return c->vt->transmittance(c->self, ray, ctx, rng);
-}
-
-static void counted_estimator_destroy(void *self) { (void)self; /* counted_destroy frees the estimator */ }
-
-static murk_rgb counted_estimate(const void *self, const murk_ray *ray, const murk_path_ctx *ctx, murk_rng *rng)
-{
-    const counted *c = self;
-    murk_thread_counters[c->slot].shadow++;
-    return c->tr_vt->estimate(c->tr_self, ray, ctx, rng);
-}
-
-static const murk_medium_vt counted_vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, NULL, counted_destroy,
-                                          counted_sample, counted_transmittance};
-
-static const murk_transmittance_vt counted_est_vt = {sizeof(murk_transmittance_vt), MURK_KIND_TRANSMITTANCE, NULL,
-                                                     counted_estimator_destroy, counted_estimate};
-
-void murk_host_count_medium(murk_medium *m, unsigned slot)
-{
-    if (!m->vt || !m->self)
-        return;
-    counted *c = murk_xmalloc(sizeof *c);
-    *c = (counted){m->vt, m->self, m->tr_self ? m->tr_vt : NULL, m->tr_self, slot};
-    m->vt = &counted_vt;
-    m->self = c;
-    if (c->tr_vt) {
-        m->tr_vt = &counted_est_vt;
-        m->tr_self = c;
-    }
+    murk_thread_counters_reset();
 }
 
 static void *host_alloc(size_t n) { return calloc(1, n ? n : 1); }
@@ -258,10 +183,23 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     return er.tfar < 0.0f;
 }
 
-/* Light sampling lives in lights.c; 1.3's services are the area strategy. */
+/* Light sampling lives in lights.c. An integrator older than MURK_ABI_MINOR_LIGHTS holds a shorter
+ * murk_light_sample (no flags): it gets that much, filled from a whole one. */
+static int host_sample_light_with(const murk_scene *s, murk_vec3 p, const float u[3], int strategy,
+                                  murk_light_sample *ls)
+{
+    if (!s->legacy_lights)
+        return murk_lights_sample(s, p, u, strategy, ls);
+    murk_light_sample whole;
+    int ok = murk_lights_sample(s, p, u, strategy, &whole);
+    memcpy(ls, &whole, MURK_LIGHT_SAMPLE_SIZE_1_6);
+    return ok;
+}
+
+/* 1.3's services are the area strategy. */
 static int host_sample_light(const murk_scene *s, murk_vec3 p, const float u[3], murk_light_sample *ls)
 {
-    return murk_lights_sample(s, p, u, MURK_LIGHT_AREA, ls);
+    return host_sample_light_with(s, p, u, MURK_LIGHT_AREA, ls);
 }
 
 static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
@@ -269,11 +207,6 @@ static float host_light_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h)
     return murk_lights_pdf(s, p, h, MURK_LIGHT_AREA);
 }
 
-static murk_rgb host_background(const murk_scene *s, murk_vec3 dir)
-{
-    (void)dir;
-    return s->background;
-}
 
 static const murk_medium *host_camera_medium(const murk_scene *s) { return s->camera_medium; }
 
@@ -291,7 +224,7 @@ static const murk_host host_table = {
     .occluded = host_occluded,
     .sample_light = host_sample_light,
     .light_pdf = host_light_pdf,
-    .background = host_background,
+    .background = murk_lights_background,
     .camera_medium = host_camera_medium,
     .density = murk_media_density,
     .walk_init = murk_media_walk_init,
@@ -300,9 +233,10 @@ static const murk_host host_table = {
     .phase_eval = murk_phase_hg_eval,
     .phase_sample = murk_phase_hg_sample,
     .counters = murk_media_counters,
-    .sample_light_with = murk_lights_sample,
+    .sample_light_with = host_sample_light_with,
     .light_pdf_with = murk_lights_pdf,
     .boundaries = host_boundaries,
+    .environment_pdf = murk_lights_environment_pdf,
 };
 
 const murk_host *murk_host_table(void) { return &host_table; }

@@ -8,8 +8,10 @@
  * (Urena, Fajardo and King 2013, "An Area-Preserving Parametrization for Spherical Rectangles"), except
  * from points that see the rectangle under less than MIN_RECT_OMEGA or lie on its plane up to PLANE_EPS
  * (a hit on the light itself): those sample it by area, and murk_lights_pdf() follows the same rule. */
-#include "accel.h"
-#include "util.h"
+#include "render/lights.h"
+#include "render/accel.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -24,9 +26,53 @@ static void add_light(murk_scene *s, size_t *cap, const murk_light *l)
     s->lights[s->nlights++] = *l;
 }
 
-void murk_lights_build(murk_scene *s)
+/* The centre and radius of the scene's bounding sphere: the Embree scene's box (the origin and 1 when
+ * the scene has no shapes). */
+static double scene_radius(const murk_scene *s)
+{
+    struct RTCBounds b;
+    rtcGetSceneBounds(s->rtc, &b);
+    if (!(b.upper_x >= b.lower_x && b.upper_y >= b.lower_y && b.upper_z >= b.lower_z))
+        return 1.0;
+    double dx = (double)b.upper_x - b.lower_x, dy = (double)b.upper_y - b.lower_y, dz = (double)b.upper_z - b.lower_z;
+    double r = 0.5 * sqrt(dx * dx + dy * dy + dz * dz);
+    return r > 0.0 ? r : 1.0;
+}
+
+static void shape_lights(murk_scene *s, size_t *cap);
+static void add_scene_lights(murk_scene *s, size_t *cap);
+static double light_weight(const murk_scene *s, const murk_light *l, double R);
+static void rect_lights(murk_scene *s);
+
+int murk_lights_build(murk_scene *s, char *err, size_t errlen)
 {
     size_t cap = 0;
+    for (size_t i = 0; s->legacy_lights && i < s->nadded; i++)
+        if (!murk_light_is_env(&s->added[i]))
+            return murk_err_file(err, errlen, s->doc.file, "the integrator predates plugin ABI 1.%d and cannot sample "
+                                 "point, spot or delta distant lights, which nothing else can reach: rebuild it "
+                                 "against this murk", MURK_ABI_MINOR_LIGHTS);
+    shape_lights(s, &cap);
+    add_scene_lights(s, &cap);
+    s->light_cdf = murk_xmalloc((s->nlights + 1) * sizeof(float));
+    double total = 0.0, run = 0.0, R = scene_radius(s);
+    for (size_t i = 0; i < s->nlights; i++)
+        total += light_weight(s, &s->lights[i], R);
+    for (size_t i = 0; i < s->nlights; i++) {
+        double w = light_weight(s, &s->lights[i], R);
+        s->light_cdf[i] = total > 0 ? (float)(run / total) : 0.0f;
+        s->lights[i].pmf = total > 0 ? (float)(w / total) : 0.0f;
+        run += w;
+    }
+    s->light_cdf[s->nlights] = 1.0f;
+    s->light_power = (float)total;
+    rect_lights(s);
+    return 0;
+}
+
+/* One light per emitting triangle or sphere of the shapes. */
+static void shape_lights(murk_scene *s, size_t *cap)
+{
     for (size_t i = 0; i < s->nshapes; i++) {
         murk_shape *sh = &s->shapes[i];
         if (murk_rgb_max(sh->emission) <= 0.0f)
@@ -36,11 +82,11 @@ void murk_lights_build(murk_scene *s)
         l.geom = (uint32_t)i;
         l.le = sh->emission;
         if (sh->type == MURK_SHAPE_SPHERE) {
-            l.sphere = 1;
+            l.kind = MURK_LK_SPHERE;
             l.center = sh->center;
             l.radius = sh->radius;
             l.area = 4.0f * MURK_PI * sh->radius * sh->radius;
-            add_light(s, &cap, &l);
+            add_light(s, cap, &l);
             continue;
         }
         for (uint32_t t = 0; t < sh->ntris; t++) {
@@ -55,22 +101,47 @@ void murk_lights_build(murk_scene *s)
             murk_vec3 cr = murk_cross(l.e1, l.e2);
             l.area = 0.5f * murk_length(cr);
             l.n = murk_normalize(cr);
-            add_light(s, &cap, &l); /* degenerate triangles get area 0 and are never picked */
+            add_light(s, cap, &l); /* degenerate triangles get area 0 and are never picked */
         }
     }
-    s->light_cdf = murk_xmalloc((s->nlights + 1) * sizeof(float));
-    double total = 0.0, run = 0.0;
-    for (size_t i = 0; i < s->nlights; i++)
-        total += (double)murk_luminance(s->lights[i].le) * s->lights[i].area;
-    for (size_t i = 0; i < s->nlights; i++) {
-        double w = (double)murk_luminance(s->lights[i].le) * s->lights[i].area;
-        s->light_cdf[i] = total > 0 ? (float)(run / total) : 0.0f;
-        s->lights[i].pmf = total > 0 ? (float)(w / total) : 0.0f;
-        run += w;
+}
+
+/* The added lights after the shapes' (an environment with parts: the constant background as one more,
+ * so that every direction of it is sampled), and the environment's list. */
+static void add_scene_lights(murk_scene *s, size_t *cap)
+{
+    size_t first = s->nlights, nenv = 0;
+    for (size_t i = 0; i < s->nadded; i++)
+        nenv += murk_light_is_env(&s->added[i]);
+    for (size_t i = 0; i < s->nadded; i++)
+        add_light(s, cap, &s->added[i]);
+    if (nenv > 0 && !murk_rgb_is_black(s->background)) {
+        murk_light l = {0};
+        l.kind = MURK_LK_ENVMAP;
+        l.le = s->background;
+        add_light(s, cap, &l);
+        nenv++;
     }
-    s->light_cdf[s->nlights] = 1.0f;
-    s->light_power = (float)total;
-    /* quads and box faces: triangles 2q (p0 p1 p2) and 2q + 1 (p0 p2 p3) of a rectangle (load.c's put_quad) */
+    s->env = murk_xmalloc((nenv ? nenv : 1) * sizeof *s->env);
+    s->nenv = 0;
+    for (size_t i = first; i < s->nlights; i++)
+        if (murk_light_is_env(&s->lights[i]))
+            s->env[s->nenv++] = i;
+}
+
+/* The selection weight of a light: its power over pi (lights.h). Emitting triangles and spheres keep the
+ * product murk always computed (luminance x area), so scenes without added lights choose bit for bit as
+ * before; a legacy integrator never gets an added light. */
+static double light_weight(const murk_scene *s, const murk_light *l, double R)
+{
+    if (l->kind == MURK_LK_TRIANGLE || l->kind == MURK_LK_SPHERE)
+        return (double)murk_luminance(l->le) * l->area;
+    return s->legacy_lights ? 0.0 : murk_light_added_weight(l, R);
+}
+
+/* quads and box faces: triangles 2q (p0 p1 p2) and 2q + 1 (p0 p2 p3) of a rectangle (load.c's put_quad) */
+static void rect_lights(murk_scene *s)
+{
     for (size_t i = 0; i < s->nshapes; i++) {
         const murk_shape *sh = &s->shapes[i];
         if (sh->light_base < 0 || (sh->type != MURK_SHAPE_QUAD && sh->type != MURK_SHAPE_BOX))
@@ -241,8 +312,8 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
     const murk_light *l = &s->lights[lo];
     if (l->pmf <= 0.0f)
         return 0;
-    if (l->sphere)
-        return sample_sphere(l, p, u, ls);
+    if (l->kind != MURK_LK_TRIANGLE)
+        return l->kind == MURK_LK_SPHERE ? sample_sphere(l, p, u, ls) : murk_lights_sample_added(s, l, p, u, ls);
     if (strategy == MURK_LIGHT_SOLID_ANGLE && l->rect) {
         int ok = sample_rect(l, p, u, ls);
         if (ok >= 0)
@@ -276,7 +347,7 @@ float murk_lights_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h, int s
     if (h->light < 0 || (size_t)h->light >= s->nlights)
         return 0.0f;
     const murk_light *l = &s->lights[h->light];
-    if (l->sphere) {
+    if (l->kind == MURK_LK_SPHERE) {
         float d = murk_length(murk_sub(l->center, p));
         if (d <= l->radius * 1.0001f)
             return 0.0f;
@@ -293,4 +364,27 @@ float murk_lights_pdf(const murk_scene *s, murk_vec3 p, const murk_hit *h, int s
     if (cosl <= 0.0f)
         return 0.0f;
     return l->pmf * dist2 / (cosl * l->area);
+}
+
+/* ---- the environment ------------------------------------------------------------------------------- */
+
+murk_rgb murk_lights_background(const murk_scene *s, murk_vec3 dir)
+{
+    if (s->nenv == 0)
+        return s->background;
+    murk_rgb L = murk_rgb1(0.0f);
+    for (size_t i = 0; i < s->nenv; i++)
+        L = murk_rgb_add(L, murk_light_env_radiance(&s->lights[s->env[i]], dir));
+    return L;
+}
+
+float murk_lights_environment_pdf(const murk_scene *s, murk_vec3 dir)
+{
+    float pdf = 0.0f;
+    for (size_t i = 0; i < s->nenv; i++) {
+        const murk_light *l = &s->lights[s->env[i]];
+        if (l->pmf > 0.0f)
+            pdf += l->pmf * murk_light_env_pdf(l, dir);
+    }
+    return pdf;
 }

@@ -4,7 +4,7 @@
  * wait (a broadcast, a sum, the sends' delivery) tests and sleeps 0.2 ms between tests instead of
  * blocking in MPI: Open MPI's blocking calls spin, and a rank spinning at the end of a pass would take
  * a core from the render threads of a rank sharing its machine. */
-#include "mpi_job.h"
+#include "render/mpi_job.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -13,7 +13,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include "util.h"
+#include "util/util.h"
 
 /* Message tags of the tile protocol (render.c). */
 enum { MURK_TAG_REQ = 1, MURK_TAG_TILE, MURK_TAG_END, MURK_TAG_RESULT, MURK_TAG_MSG };

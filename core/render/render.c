@@ -14,13 +14,14 @@
  * per pixel). The other ranks never hold the image: their render threads advance a tile's state in the
  * TILE message it came in (a held tile), so a rank's memory is its threads + 1 tiles of 7 KB whatever
  * the image's size. After each pass the ranks' rays, NaN counts and busy time are summed into rank 0. */
-#include "camera.h"
-#include "checkpoint.h"
-#include "error.h"
-#include "host.h"
-#include "mpi_job.h"
-#include "scene.h"
-#include "util.h"
+#include "render/camera.h"
+#include "render/checkpoint.h"
+#include "render/host.h"
+#include "render/mpi_job.h"
+#include "scene/scene.h"
+#include "util/error.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -211,7 +212,7 @@ static void *worker(void *arg)
     atomic_fetch_add(&j->rays, murk_host_thread_rays());
     atomic_fetch_add(&j->nonfinite, bad);
     pthread_mutex_lock(&j->lock);
-    murk_host_thread_counters_add(j->media, j->nslots);
+    murk_thread_counters_add(j->media, j->nslots);
     if (peak > j->max_sample)
         j->max_sample = peak;
     pthread_mutex_unlock(&j->lock);

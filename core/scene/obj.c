@@ -17,10 +17,10 @@
  * one float multiplication or division (Clinger's fast path); anything else goes to strtof in the
  * "C" locale (switched for this thread only), which is correctly rounded too: both give the same
  * bits whatever locale the application has set. */
-#include "obj.h"
-#include "error.h"
-#include "file.h"
-#include "limit.h"
+#include "scene/obj.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/limit.h"
 
 #include <errno.h>
 #include <locale.h>

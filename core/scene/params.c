@@ -1,13 +1,12 @@
 /* params.c — plugin parameter blocks: reading a plugin's keys from the scene against the plugin's
  * schema (types, ranges, choices, textures, required keys), for the scene loader (load.c) and the
  * media loader (media.c). */
-#include "params.h"
-#include "host.h"
-#include "media.h"
-#include "scene.h"
-#include "texture.h"
-#include "util.h"
-#include "yread.h"
+#include "scene/params.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+#include "util/runtime.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include "murk/integrator.h"
 #include "murk/material.h"
@@ -86,7 +85,8 @@ static int dropped_by_swap(const murk_ynode *map, size_t k, uint32_t kind, const
 /* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
  * block in messages, e.g. "material 'metal' (ggx)". */
 int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
-                                  const char *const *skip, size_t nskip, murk_value *values, char *err, size_t errlen)
+                                  const char *const *skip, size_t nskip, int note_drops, murk_value *values, char *err,
+                                  size_t errlen)
 {
     for (uint32_t i = 0; i < d->nparams; i++) {
         const murk_param *p = &d->params[i];
@@ -108,7 +108,7 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
         for (uint32_t i = 0; i < d->nparams; i++)
             if (strcmp(d->params[i].name, key) == 0)
                 idx = (int)i;
-        if (idx < 0 && dropped_by_swap(map, k, d->kind, who, d->params != murk_medium_core_params))
+        if (idx < 0 && dropped_by_swap(map, k, d->kind, who, note_drops))
             continue;
         if (idx < 0) {
             const char *cand[96];
@@ -190,19 +190,18 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
     return 0;
 }
 
-int murk_scene_instantiate(murk_scene *s, int kind, const murk_ynode *type_node, const char *type, const murk_ynode *map,
-                           const char *block, const char *who, const char *const *skip, size_t nskip,
-                           const murk_medium_data *data, const murk_plugin **plugin, void **self, char *err,
-                           size_t errlen)
+int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node,
+                           const char *type, const murk_ynode *map, const char *block, const char *who,
+                           const char *const *skip, size_t nskip, const murk_medium_data *data,
+                           const murk_plugin **plugin, void **self, char *err, size_t errlen)
 {
     char lerr[1024];
     const murk_plugin *p = murk_registry_load(&s->reg, kind, type, lerr, sizeof lerr);
     if (!p)
         return ERR(type_node, "%s: %s", block, lerr);
     murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
-    if (murk_scene_read_plugin_params(s, p->desc, map, who, skip, nskip, vals, err, errlen))
+    if (murk_scene_read_plugin_params(s, p->desc, map, who, skip, nskip, 1, vals, err, errlen))
         return -1;
-    const murk_host *host = murk_host_table();
     char cerr[512] = "";
     int rc;
     switch (kind) {

@@ -1,5 +1,5 @@
-/* scene.h — the scene as the core holds it after loading and validation (load.c loads it, scene.c frees
- * it). Internal to libmurk. */
+/* scene.h — the scene as the core holds it after loading and validation: data only (load/load.c builds
+ * it, load/free.c frees it). Internal to libmurk. */
 #ifndef MURK_SCENE_H
 #define MURK_SCENE_H
 
@@ -9,8 +9,8 @@
 #include "murk/material.h"
 #include "murk/medium.h"
 #include "murk/murk.h"
-#include "plugin_loader.h"
-#include "yamldoc.h"
+#include "plugin/plugin_loader.h"
+#include "yaml/yamldoc.h"
 
 typedef enum { MURK_SHAPE_QUAD, MURK_SHAPE_SPHERE, MURK_SHAPE_BOX, MURK_SHAPE_MESH } murk_shape_type;
 
@@ -31,14 +31,32 @@ typedef struct murk_shape {
     char *name;                                /* mesh: its file as the scene names it (owned), else NULL */
 } murk_shape;
 
+/* What a light is: an emitting triangle or sphere of a shape (render/lights.c), or one of the scene's
+ * `lights:` (load/light_block.c, or C: render/lights.h). */
+typedef enum murk_light_kind {
+    MURK_LK_TRIANGLE = 0,
+    MURK_LK_SPHERE = 1,
+    MURK_LK_POINT,   /* center, le = intensity (W/sr) */
+    MURK_LK_SPOT,    /* center, n = axis (where it shines), le = intensity, cos_falloff, cos_cone */
+    MURK_LK_DISTANT, /* n = unit direction towards it, le = irradiance E; omc > 0: a cone, radiance lc */
+    MURK_LK_ENVMAP   /* env (NULL: a constant environment of radiance le); part of the environment */
+} murk_light_kind;
+
+typedef struct murk_envmap murk_envmap; /* a lat-long environment map (render/envmap.h) */
+
 typedef struct murk_light {
     uint32_t geom, prim;
-    int sphere;
+    int kind; /* murk_light_kind */
     murk_vec3 p0, e1, e2, n; /* triangle: p0 + a e1 + b e2; unit normal (emitting side) */
     murk_vec3 center;        /* sphere */
     float radius, area;
     float pmf; /* probability of picking this light */
     murk_rgb le;
+    /* spot: the cosines of falloff_angle (full intensity) and cone_angle (none); distant: 1 - cos of
+     * its cone's half-angle (0: a delta light) and the radiance inside the cone */
+    float cos_falloff, cos_cone, omc;
+    murk_rgb lc;
+    const murk_envmap *env;
     /* a triangle of a rectangle (a quad or box face: two triangles): the rectangle p0 + a ex + b ey,
      * a, b in [0, 1], and the probability of picking either of its triangles (MURK_LIGHT_SOLID_ANGLE) */
     int rect;
@@ -94,39 +112,20 @@ struct murk_scene {
     size_t nlights;
     float *light_cdf; /* nlights + 1 */
     float light_power;
+    /* the `lights:` block's lights (and those added from C), until murk_lights_build appends them to
+     * `lights`; the environment maps they own */
+    murk_light *added;
+    size_t nadded;
+    murk_envmap **envmaps;
+    size_t nenvmaps;
+    /* the environment's parts (indices into lights: envmaps, finite-cone distant lights, and the constant
+     * background as a constant envmap when there are others); none: background() is the constant */
+    size_t *env;
+    size_t nenv;
+    int legacy_lights; /* the integrator predates MURK_ABI_MINOR_LIGHTS: the added lights get pmf 0 */
     RTCDevice device;
     RTCScene rtc;
     long long embree_bytes; /* what Embree holds for the scene (its memory monitor: BVH, buffers) */
 };
-
-/* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
- * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the
- * camera; did you mean media.OTHER?" (or "--set ...: ..." for one a --set made). murk_scene_load itself
- * refuses only those a --set made (a misspelt name): embedders may load media and materials to call
- * them directly. Returns 0, or -1 with err. */
-int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
-
-/* The content hash a checkpoint carries: the scene file and every file it loads (meshes, density
- * grids, image textures, as named after the --set overrides), each with its path; so a resume after
- * any of them changed is refused. 0 with err if one cannot be read. */
-uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
-
-/* Releases what a shape owns (its triangle arrays). */
-void murk_shape_free(murk_shape *sh);
-
-/* What a loaded scene holds in memory, item by item (memory.c): each medium's density field with its bound grid,
- * each mesh (positions, uvs, normals, indices, triangle normals), each texture (texels as floats), and Embree's
- * scene (its BVH and its copies of the buffers, as its memory monitor counts them). Bytes as allocated, without
- * the allocator's own overhead. */
-typedef struct murk_mem_item {
-    const char *kind;   /* "grid", "mesh", "texture", "embree" */
-    char name[160];     /* the medium, the file, or "scene" */
-    char detail[160];   /* e.g. "sparse, 32221669 active voxels in 68051 bricks" */
-    uint64_t bytes;
-} murk_mem_item;
-/* Fills items[0..cap) and returns how many there are (it may exceed cap: call again with more room). */
-size_t murk_scene_memory(const murk_scene *s, murk_mem_item *items, size_t cap);
-/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
-long murk_peak_rss_kb(void);
 
 #endif

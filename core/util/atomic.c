@@ -1,9 +1,9 @@
 /* atomic.c — the one way murk writes an output file: a temporary beside the target, flushed to disk,
  * then renamed over it; groups of files committed together; temporaries removed on SIGINT/SIGTERM/
  * SIGHUP; only regular files replaced (see atomic.h). */
-#include "atomic.h"
-#include "error.h"
-#include "util.h"
+#include "util/atomic.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -5,7 +5,7 @@
 #if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE
 #endif
-#include "util.h"
+#include "util/util.h"
 
 #include <unistd.h>
 #if defined(__linux__)

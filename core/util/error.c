@@ -1,7 +1,7 @@
 /* error.c — the one formatter of loader errors: "file:line:col: what is wrong" or "file: what is wrong"
  * (see error.h). */
-#include "error.h"
-#include "util.h"
+#include "util/error.h"
+#include "util/util.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
 /* file.c — reading input files whole (the density grid readers). */
-#include "file.h"
-#include "error.h"
-#include "limit.h"
+#include "util/file.h"
+#include "util/error.h"
+#include "util/limit.h"
 
 #include <errno.h>
 #include <fcntl.h>

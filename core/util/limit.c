@@ -1,6 +1,7 @@
 /* limit.c — the limits murk enforces on input sizes, with their environment overrides (limit.h). */
-#include "limit.h"
-#include "util.h"
+#include "util/limit.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -14,6 +15,7 @@ static const struct {
     [MURK_LIMIT_GRID_VOXELS] = {"MURK_MAX_GRID_VOXELS", (uint64_t)1 << 27},
     [MURK_LIMIT_FILE_BYTES] = {"MURK_MAX_FILE_BYTES", (uint64_t)1 << 30},
     [MURK_LIMIT_MESH_TRIANGLES] = {"MURK_MAX_MESH_TRIANGLES", (uint64_t)1 << 26},
+    [MURK_LIMIT_PAGE_BYTES] = {"MURK_MAX_PAGE_BYTES", (uint64_t)1 << 26},
     [MURK_LIMIT_GRID_BOX] = {"MURK_MAX_GRID_BOX", (uint64_t)1 << 40},
 };
 

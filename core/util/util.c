@@ -1,13 +1,11 @@
 /* util.c — small helpers internal to libmurk. */
-#include "util.h"
+#include "util/util.h"
 
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-static int quiet;
 
 MURK_API void *murk_xmalloc(size_t n)
 {
@@ -107,8 +105,6 @@ double murk_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-MURK_API void murk_set_quiet(int q) { quiet = q; }
-
 /* Length of the valid UTF-8 sequence at s (2..4), or 0 if there is none. */
 static size_t utf8_len(const unsigned char *s)
 {
@@ -170,14 +166,16 @@ MURK_API char *murk_printable(char *dst, size_t n, const char *src)
     return dst;
 }
 
-MURK_API void murk_log(int level, const char *fmt, ...)
+/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
+MURK_API long murk_peak_rss_kb(void)
 {
-    if (quiet && level == MURK_LOG_INFO)
-        return;
-    char raw[2048], safe[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(raw, sizeof raw, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "%s%s\n", level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", murk_printable(safe, sizeof safe, raw));
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    long kb = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return kb;
 }

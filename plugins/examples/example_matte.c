@@ -93,8 +93,16 @@ static int matte_sample(const void *self, const murk_hit *hit, murk_vec3 wo, con
     return 1;
 }
 
+/* Designated initialisers: methods a later ABI minor appends start NULL (murk/material.h's prepared
+ * methods of ABI 1.7 are optional), and the vtable compiles without warnings against newer headers. */
 static const murk_material_vt vt = {
-    sizeof(murk_material_vt), MURK_KIND_MATERIAL, matte_create, matte_destroy, matte_eval, matte_pdf, matte_sample,
+    .size = sizeof(murk_material_vt),
+    .kind = MURK_KIND_MATERIAL,
+    .create = matte_create,
+    .destroy = matte_destroy,
+    .eval = matte_eval,
+    .pdf = matte_pdf,
+    .sample = matte_sample,
 };
 
 MURK_MATERIAL_PLUGIN("example_matte", "example: tinted Lambertian (copy me)", params, P_COUNT, &vt)

@@ -11,27 +11,54 @@
  *
  * The functions with external linkage are hidden in the plugin (only the entry symbols are exported). */
 #include "pathtracer.h"
+#ifdef MURK_PT_TAP
+#include "pathtracer_tap.h"
+#endif
 
 #include <math.h>
 #include <stdio.h>
 
 #include "murk/material.h"
 
+/* Each parameter's only description (murk plugins NAME prints it; docs/plugins.md is generated from it). */
 #define PT_SHARED_PARAMS \
     [MURK_PT_MAX_DEPTH] = {"max_depth", MURK_PARAM_INT, 0, {64, 0, 0}, NULL, NULL, 1, 100000, \
-                           "most scattering events (surface or medium) per path"}, \
+                           "the most scattering events (surface bounces and, in volpath and volpath_nee, medium " \
+                           "scattering) a path may take; light found after the last one still counts, so 1 is " \
+                           "direct light only"}, \
     [MURK_PT_RR_DEPTH] = {"rr_depth", MURK_PARAM_INT, 0, {3, 0, 0}, NULL, NULL, 0, 100000, \
-                          "scattering events before Russian roulette may end a path"}, \
+                          "scattering events before Russian roulette may end a path; survivors are divided by " \
+                          "their survival probability, so roulette adds noise but no bias"}, \
     [MURK_PT_LIGHT_SAMPLING] = {"light_sampling", MURK_PARAM_ENUM, 0, {0, 0, 0}, "area", "area|solid_angle", 0, 0, \
-                                "NEE: every light triangle by area, or rectangular lights by solid angle"}, \
+                                "how next-event estimation picks a point on a light: area, every emitting " \
+                                "triangle uniformly by area (a rectangular quad or box face as its whole " \
+                                "rectangle); solid_angle, a rectangular quad or box face uniformly in the solid " \
+                                "angle it subtends (Urena et al. 2013; tiny ones and other shapes by area). " \
+                                "solid_angle is far less noisy for points close to a light but costs more per " \
+                                "sample, and at equal time it was at best even with area (docs/results.md, " \
+                                "\"Light sampling\"), so area is the default. Both render the same image " \
+                                "(tests/test_lights.c)"}, \
     [MURK_PT_RR_THRESHOLD] = {"rr_threshold", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.001, 1, \
-                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold)"},
+                              "Russian roulette keeps a path with probability min(1, weight / rr_threshold), at " \
+                              "least 0.05: 1 plays with every path whose weight fell below 1, 0.1 (Tungsten's " \
+                              "rule) only with the paths below a tenth: longer paths and less noise per sample, " \
+                              "but no better per second (docs/results.md)"},
 
 const murk_param murk_pt_params[MURK_PT_NPARAMS] = {PT_SHARED_PARAMS};
 const murk_param murk_pt_nee_params[MURK_PT_NEE_NPARAMS] = {
     PT_SHARED_PARAMS
     [MURK_PT_EQUIANGULAR] = {"equiangular", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
-                             "also sample each medium segment equiangularly towards a light point (MIS)"},
+                             "also sample each medium segment equiangularly (Kulla and Fajardo 2012) towards a "
+                             "reference point on a light (a point or spot light's position; a reference light at "
+                             "infinity, a distant light or the environment, has no point: that segment has free "
+                             "flights alone), and combine that vertex's NEE with the free flight's "
+                             "by MIS (the balance heuristic; a per-segment exponential stands in for the free "
+                             "flight's pdf, exact in a grey homogeneous medium and an approximation elsewhere, "
+                             "which changes the noise, never the image). Free flights are untouched. It pays off "
+                             "where single scattering of a light dominates and free flights rarely scatter near "
+                             "it (a lamp in or beside thin fog: scenes/fog_lamp.yaml); it costs more per sample, "
+                             "is about even in an optically thin-to-moderate medium and loses in a dense cloud "
+                             "(docs/results.md, \"Equiangular sampling\"), so it is off by default"},
 };
 
 /* The plugin's name, for the watchdog's reports. */
@@ -145,22 +172,28 @@ static murk_ray ray_from(murk_vec3 o, murk_vec3 d)
 /* An origin offset along a boundary's normal is off the original line from p to q: a leg that kept
  * the first direction, with a length measured along it, reaches a light parallel to the boundary
  * early and counts the light itself as an occluder. So every leg is re-aimed at q. */
-murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
-                        const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+/* A light at infinity (inf = 1) is reached along wi itself: every leg keeps that direction and runs to
+ * infinity (a medium's majorant walk ends at its density's box; a constant medium is bounded by its
+ * boundary shapes). */
+static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
+                       murk_vec3 wi, int inf, const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
 {
     const murk_host *h = pt->host;
-    const float end_eps = 1e-4f * murk_maxf(1.0f, maxabs(q));
+    const float end_eps = inf ? 0.0f : 1e-4f * murk_maxf(1.0f, maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
     if (!pt->media)
         m = NULL;
-    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, murk_sub(q, p)) : p;
+    murk_vec3 o = murk_dot(offset_n, offset_n) > 0.0f ? offset(p, offset_n, inf ? wi : murk_sub(q, p)) : p;
     for (int crossings = 0; crossings < 256; crossings++) {
-        murk_vec3 d = murk_sub(q, o);
-        float len = murk_length(d);
-        if (!(len > end_eps))
-            return T;
-        murk_ray r = ray_from(o, murk_mul(d, 1.0f / len));
-        r.tmax = len - end_eps;
+        murk_ray r = ray_from(o, wi);
+        if (!inf) {
+            murk_vec3 d = murk_sub(q, o);
+            float len = murk_length(d);
+            if (!(len > end_eps))
+                return T;
+            r = ray_from(o, murk_mul(d, 1.0f / len));
+            r.tmax = len - end_eps;
+        }
         if (!m && !h->occluded(scene, &r)) /* nothing at all in the way: the common case, cheaply */
             return T;
         if (!m && !h->boundaries(scene)) /* in the way, and without boundaries it is an occluder */
@@ -191,6 +224,18 @@ murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p,
     return murk_rgb1(0.0f);
 }
 
+murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
+                        const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    return shadow(pt, scene, p, offset_n, q, murk_v3(0, 0, 0), 0, m, ctx, rng);
+}
+
+murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 wi,
+                            const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng)
+{
+    return shadow(pt, scene, p, offset_n, p, wi, 1, m, ctx, rng);
+}
+
 /* ---- path state ---------------------------------------------------------------------------- */
 
 typedef struct path {
@@ -208,7 +253,8 @@ typedef struct path {
                       * radiance picks up entering a denser medium (for Russian roulette only) */
 } path;
 
-/* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h). */
+/* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h), which
+ * a build with the tap reports (pathtracer_tap.h). */
 static void add_light(path *st, murk_rgb le, float w, int term)
 {
     murk_rgb c = murk_rgb_scale(murk_rgb_mul(st->beta, le), w / mean3(st->R));
@@ -228,12 +274,13 @@ static void add_light(path *st, murk_rgb le, float w, int term)
 #endif
 
 /* What a scattering vertex scatters with: a material in its shading frame (flipped to wo's side; the
- * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside) or the medium's
+ * hit the material gets has n flipped with it, so n . ng < 0 tells it wo is inside), prepared once for
+ * the vertex (its textures read once for light sampling and BSDF sampling alike), or the medium's
  * phase function (mat == NULL). */
 typedef struct vertex {
     murk_vec3 p, offset_n, wo; /* offset_n: the geometric normal at a surface flipped to wo's side, zero in a medium */
     const murk_material *mat;
-    const murk_hit *hit;
+    const murk_shading *sp; /* the material's shading point at the vertex */
     murk_vec3 t, b, n, wo_local;
     float g;
     const murk_medium *behind; /* the medium on the far side of the surface from wo */
@@ -256,7 +303,7 @@ static murk_rgb vertex_f(const murk_host *h, const vertex *v, murk_vec3 wi)
     murk_vec3 wl = murk_to_local(wi, v->t, v->b, v->n);
     if (!vertex_side_ok(v, wi, wl))
         return murk_rgb1(0.0f);
-    return murk_rgb_scale(v->mat->vt->eval(v->mat->self, v->hit, v->wo_local, wl), fabsf(wl.z));
+    return murk_rgb_scale(murk_material_eval(v->mat, v->sp, v->wo_local, wl), fabsf(wl.z));
 }
 
 /* The solid-angle pdf with which the vertex samples wi. */
@@ -264,7 +311,7 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 {
     if (!v->mat)
         return h->phase_eval(v->g, v->wo, wi);
-    return v->mat->vt->pdf(v->mat->self, v->hit, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
+    return murk_material_pdf(v->mat, v->sp, v->wo_local, murk_to_local(wi, v->t, v->b, v->n));
 }
 
 static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v,
@@ -281,6 +328,7 @@ static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, c
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
+    ls.flags = 0;
     if (w > 0.0f && pt->host->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
         add_light(st, light_sample_value(pt, scene, st, v, &ls, rng), w, term);
 }
@@ -300,9 +348,13 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
         return f;
     /* a light behind a transmitting surface is reached through the medium on that side */
     const murk_medium *m = v->mat && murk_dot(ls->wi, v->offset_n) < 0.0f ? v->behind : st->medium;
-    murk_rgb T = murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m, &st->ctx, rng);
+    murk_rgb T = isinf(ls->dist) ? murk_pt_shadow_inf(pt, scene, v->p, v->offset_n, ls->wi, m, &st->ctx, rng)
+                                 : murk_pt_shadow(pt, scene, v->p, v->offset_n, murk_madd(v->p, ls->wi, ls->dist), m,
+                                                  &st->ctx, rng);
     if (murk_rgb_is_black(T))
         return T;
+    if (ls->flags & MURK_LIGHT_SAMPLE_DELTA) /* no BSDF or phase sample can hit a delta light: weight 1 */
+        return murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(f, T), ls->le), 1.0f / ls->pdf);
     float pdf = vertex_pdf(h, v, ls->wi);
     if (!isfinite(pdf)) {
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
@@ -366,8 +418,9 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     u[0] = murk_sample_1d(rng);
     murk_sample_2d(rng, u + 1);
     murk_light_sample ls;
-    if (!h->sample_light_with(scene, st->ray.o, u, pt->light_strategy, &ls))
-        return;
+    ls.flags = 0;
+    if (!h->sample_light_with(scene, st->ray.o, u, pt->light_strategy, &ls) || isinf(ls.dist))
+        return; /* a light at infinity has no point to aim at: this segment has free flights alone */
     murk_vec3 q = murk_madd(st->ray.o, ls.wi, ls.dist);
     /* where the medium can scatter along the segment, and its mean density there */
     murk_majorant_walk w;
@@ -500,7 +553,8 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     v.wo = wo;
     v.mat = hit->material;
     murk_hit mh = *hit; /* the material's copy: n on wo's side */
-    v.hit = &mh;
+    murk_shading sp;
+    v.sp = &sp;
     v.offset_n = hit->ng;
     v.n = hit->n;
     v.behind = murk_dot(hit->ng, wo) >= 0.0f ? hit->interior : hit->exterior; /* the medium beyond the surface */
@@ -509,6 +563,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
         v.n = murk_neg(v.n);
     }
     mh.n = v.n;
+    murk_material_prepare(v.mat, &mh, &sp);
     murk_basis(v.n, &v.t, &v.b);
     v.wo_local = murk_to_local(wo, v.t, v.b, v.n);
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
@@ -521,7 +576,7 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     u[2] = murk_sample_1d(rng); /* PT_SLOT_LOBE */
     murk_bsdf_sample bs;
     bs.eta = 1.0f; /* a material built before ABI 1.3 does not write it */
-    if (!v.mat->vt->sample(v.mat->self, v.hit, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
+    if (!murk_material_sample(v.mat, &sp, v.wo_local, u, &bs) || !(bs.pdf > 0.0f))
         return 0;
     if (!finite3(bs.f) || !isfinite(bs.pdf) || !isfinite(bs.wi.x + bs.wi.y + bs.wi.z))
         return broken(h, "material", v.mat->name, "sample");
@@ -544,6 +599,16 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     st->ray = ray_from(offset(hit->p, v.offset_n, wi), wi);
     st->depth++;
     return 1;
+}
+
+/* The MIS weight of the environment that a BSDF / phase sample of pdf st->prev_pdf found, against the
+ * light sampling that could have picked that direction (1 where none could: a constant background). */
+static float escaped_weight(const murk_pt *pt, const murk_scene *scene, const path *st)
+{
+    if (!pt->nee || st->prev_delta)
+        return 1.0f;
+    float pe = pt->host->environment_pdf(scene, st->ray.d);
+    return pe > 0.0f ? power_heuristic(st->prev_pdf, pe) : 1.0f;
 }
 
 /* An index-matched boundary: the medium on the far side, the same direction. */
@@ -610,7 +675,7 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
             }
         }
         if (!found) {
-            add_light(&st, h->background(scene, st.ray.d), 1.0f, MURK_PT_TERM_BACKGROUND);
+            add_light(&st, h->background(scene, st.ray.d), escaped_weight(pt, scene, &st), MURK_PT_TERM_BACKGROUND);
             PT_TAP_END(&st, MURK_PT_END_ESCAPED);
             break;
         }

@@ -23,7 +23,12 @@
  * With nee = 1 every scattering vertex (surface or medium) also samples a light point and estimates
  * the transmittance to it (murk_pt_shadow); the light sample and the BSDF / phase sample are weighted
  * by the power heuristic on their solid-angle pdfs (unbiased: the weights depend on the direction
- * only and sum to 1). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
+ * only and sum to 1). A light at infinity (a distant light, the environment: dist = INFINITY) is
+ * reached by a shadow ray that runs to infinity along its direction (murk_pt_shadow_inf); a delta light
+ * (point, spot, delta distant) counts with weight 1, since no BSDF or phase sample can hit it. A ray that
+ * leaves the scene after a BSDF / phase sample adds background() weighted by the power heuristic
+ * against environment_pdf(), the pdf with which light sampling picks its direction (1 where none can:
+ * a constant background, which light sampling leaves out). With nee = 0 emission is found by BSDF / phase sampling alone — a slower,
  * independent estimator of the same image. With media = 0 (`path`) media are ignored and boundaries
  * passed straight through, by paths and shadow rays alike. Russian roulette after rr_depth events on
  * the path's largest channel weight over mean(R), relative to rr_threshold; survivors are divided by
@@ -34,7 +39,7 @@
 #include "murk/integrator.h"
 #include "murk/medium.h"
 
-/* The parameters all three integrators share (documented in each plugin's comment block). */
+/* The parameters all three integrators share (described in their schema entries, pathtracer.c). */
 enum { MURK_PT_MAX_DEPTH, MURK_PT_RR_DEPTH, MURK_PT_LIGHT_SAMPLING, MURK_PT_RR_THRESHOLD, MURK_PT_NPARAMS };
 extern const murk_param murk_pt_params[MURK_PT_NPARAMS];
 /* volpath_nee's: the shared ones, then its own. */
@@ -69,21 +74,17 @@ murk_rgb murk_pt_li(const void *self, const murk_scene *scene, const murk_ray *r
 murk_rgb murk_pt_shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 q,
                         const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
 
-/* What each contribution add_light() makes to a sample is (bench/variance_profile's tap, compiled in only
- * with -DMURK_PT_TAP, never into the plugins): light sampling at a surface vertex, at a free-flight
- * medium vertex and at the equiangular vertex; emission found by BSDF sampling, by phase sampling, by
- * the camera ray itself; the background. And how each path ended. */
+/* The same towards a light at infinity in direction wi: every leg keeps wi and runs to infinity. */
+murk_rgb murk_pt_shadow_inf(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, murk_vec3 offset_n, murk_vec3 wi,
+                            const murk_medium *m, const murk_path_ctx *ctx, murk_rng *rng);
+
+/* The techniques the path tracer tells apart, one for each contribution it makes to a sample (its
+ * `term`): light sampling at a surface vertex, at a free-flight medium vertex and at the equiangular
+ * vertex; emission found by BSDF sampling, by phase sampling, by the camera ray itself; the background.
+ * And how a path ended. Only a build with the tap (-DMURK_PT_TAP, pathtracer_tap.h: bench/variance_profile,
+ * never the plugins) reports them. */
 enum { MURK_PT_TERM_SURFACE_NEE, MURK_PT_TERM_MEDIUM_NEE, MURK_PT_TERM_EQUIANGULAR_NEE, MURK_PT_TERM_BSDF_EMISSION,
        MURK_PT_TERM_PHASE_EMISSION, MURK_PT_TERM_CAMERA_EMISSION, MURK_PT_TERM_BACKGROUND, MURK_PT_NTERMS };
 enum { MURK_PT_END_ROULETTE, MURK_PT_END_MAX_DEPTH, MURK_PT_END_ABSORBED, MURK_PT_END_ESCAPED, MURK_PT_NENDS };
-#ifdef MURK_PT_TAP
-/* Provided by the program that compiles pathtracer.c with the tap: `value` (beta Le w / mean(R), what
- * L gains) of technique `term` after `depth` scattering events (an NEE's own vertex not counted); then,
- * at most once per path, how it ended after `depth` scattering events: Russian roulette, max_depth, a
- * free flight of weight 0 (absorbed), escaped to the background. A path that ends otherwise (a BSDF
- * sample that failed or weighed 0, a non-finite value, the watchdog) reports no end. */
-void murk_pt_tap(int depth, int term, murk_rgb value);
-void murk_pt_tap_end(int depth, int why);
-#endif
 
 #endif

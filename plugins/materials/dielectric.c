@@ -1,60 +1,12 @@
-/* dielectric — a smooth or rough (GGX) dielectric interface: glass, water, a liquid's surface. Reflects
- * and transmits (murk/material.h, "Transmission"): it reads which side wo is on from the hit
- * (murk_material_wo_inside: the hit's n, flipped to wo's side by the integrator, against the shape's
- * ng) and works below in its own oriented frame, +z = outside, where wo.z < 0 means wo inside.
- *
- * Parameters
- *   ior        RGB in [1, 4], default 1.5. Index of refraction of the inside (the -ng side: inside a
- *              sphere or box, behind a quad's u x v) relative to the outside. One number for grey; three
- *              different numbers give RGB dispersion: each channel refracts with its own index (a
- *              sample then follows one channel, chosen uniformly, and carries 3x that channel's weight
- *              and 0 in the others; with roughness the pdf is the average of the channels' pdfs).
- *   roughness  float in [0, 1], default 0. 0: a smooth interface, two delta lobes (mirror reflection and
- *              Snell refraction) that eval()/pdf() do not describe and sample() marks delta = 1, so the
- *              integrators skip light sampling and MIS for it. > 0: GGX microfacet reflection and
- *              transmission (Walter et al. 2007) with alpha = roughness^2 (clamped to >= 0.001),
- *              height-correlated Smith masking-shadowing, visible-normal sampling (Dupuy & Benyoub 2023).
- *   tint       RGB in [0, 1], default 1. Multiplies transmitted light at each crossing (a thin coloured
- *              film; the colour of a thick body belongs in a medium: `interior:`).
- *   multiscatter  bool, default true. Rough only: multiple-scattering energy compensation (below), so that
- *              a rough interface without absorption loses no light; false gives the single-scattering
- *              model exactly as before it existed (for A/B: at roughness 1 it keeps 0.31 of the energy
- *              arriving from inside an ior 2.4 body at normal incidence, and a rough ior 1.5 sphere in a
- *              white furnace renders 0.36 instead of 1).
- *
- * Model (pbrt-v4's DielectricBxDF, in murk's oriented frame: +z = the shading normal = outside; wo.z < 0
- * is wo inside). eta = ior per channel; etap = eta_wi / eta_wo (eta when wo is outside and wi inside,
- * 1 / eta the other way). Fresnel is the exact unpolarised dielectric formula, total internal
- * reflection included (F = 1 past the critical angle, from inside).
- *   smooth  R = F(|wo.z|), T = 1 - R; sample() picks reflection with probability R, else refraction;
- *           f = R / |wi.z| (reflection) and T tint / (etap^2 |wi.z|) (refraction), pdf = R or T, so
- *           the path weight is exactly 1 (reflection) or tint / etap^2.
- *   rough   with wm the generalised half vector (wo + etap wi, facing +z):
- *           reflection   f = D(wm) G2(wo, wi) F(wo.wm) / (4 |wo.z| |wi.z|)
- *           transmission f = D(wm) G2(wo, wi) (1 - F) tint |wi.wm| |wo.wm| / (|wi.z| |wo.z| (wi.wm + wo.wm / etap)^2) / etap^2
- *           sampling: a visible normal of wo (the lobe of -wo when wo is inside), then reflection with
- *           probability F(wo.wm), else refraction through wm; pdf = D_wo(wm) R / (4 |wo.wm|) or
- *           D_wo(wm) T |wi.wm| / (wi.wm + wo.wm / etap)^2, D_wo(wm) = G1(wo) D(wm) |wo.wm| / |wo.z|.
- *           Microfacets facing away from wo or wi are discarded (f = pdf = 0); samples that reflect
- *           through the surface or refract back to wo's side are rejected (sample() returns 0).
- * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, their dielectric extension):
- *           the single-scattering model's energy albedo E_s(mu) (reflection + transmission, the latter as
- *           energy: radiance x etap^2; s = the side wo is on) falls short of 1 because microfacets shadow
- *           and mask each other; a compensation lobe adds exactly the missing 1 - E_s(mu_o), split between
- *           reflection and transmission so that both sides conserve energy and transmission stays
- *           reciprocal (derivation at ms_prepare). E is tabulated per side over (mu, alpha, eta) by
- *           tools/ggx_tables.c (dielectric_tables.h; its axes in dielectric_tables_axis.h); create()
- *           blends the two nearest eta nodes' rows for its ior and averages them exactly. The lobe is
- *           sampled with probability 1 - E_s(mu_o), cosine-weighted on the chosen side; pdf() is the
- *           mixture. With dispersion every channel has its own tables.
- * Transport mode: radiance. murk's integrators trace from the camera and carry radiance, so a
- * transmitted f includes (eta_wo / eta_wi)^2 — radiance is compressed into the denser medium. The
- * reciprocity that holds is eval(wo, wi) / eta_wo^2 = eval(wi, wo) / eta_wi^2. sample() reports
- * s->eta = etap for a refracted sample (1 for a reflected one). With ior 1 and roughness 0 the surface
- * is invisible (F = 0, straight through).
- *
- * Robustness: |wo.z| or |wi.z| below 1e-9 gives f = 0, pdf = 0 and no sample; every output is finite. */
+/* dielectric — a smooth or rough dielectric interface (glass, water, a liquid's surface) that reflects
+ * and transmits (murk/material.h, "Transmission"): exact Fresnel, smooth delta lobes or GGX microfacet
+ * reflection and transmission (Walter et al. 2007; pbrt-v4's DielectricBxDF) with height-correlated
+ * Smith masking-shadowing (Heitz 2014) and visible-normal sampling (Heitz 2018; Dupuy & Benyoub 2023),
+ * multiple-scattering compensation (Kulla & Conty 2017) and RGB dispersion. It works in its own
+ * oriented frame, +z = outside, where wo.z < 0 means wo inside. The model is derived in
+ * docs/materials.md; the tables come from tools/ggx_tables.c. */
 #include "murk/material.h"
+#include "murk/microfacet.h"
 
 #include <string.h>
 
@@ -96,38 +48,22 @@ typedef struct dielectric {
     di_ms tab[3];   /* per channel (only [0] when not dispersive) */
 } dielectric;
 
+/* Parameter values at one hit. */
 typedef struct di_shade {
     float alpha; /* 0: smooth */
     murk_rgb tint;
+    int inside;  /* wo is inside (murk_material_wo_inside): the oriented frame flips z */
 } di_shade;
-
-static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
 
 static void shade_at(const dielectric *d, const murk_hit *hit, di_shade *sh)
 {
     float v[3];
+    sh->inside = murk_material_wo_inside(hit);
     murk_value_eval(d->host, &d->p[P_ROUGHNESS], hit, v);
-    float r = clamp01(v[0]);
+    float r = murk_clamp01(v[0]);
     sh->alpha = r > 0.0f ? murk_maxf(r * r, DI_ALPHA_MIN) : 0.0f;
     murk_value_eval(d->host, &d->p[P_TINT], hit, v);
-    sh->tint = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
-}
-
-/* Unpolarised Fresnel reflectance for the cosine ci of the incident direction with the normal (negative:
- * from inside) and the relative index eta (inside / outside). 1 under total internal reflection. */
-static float fresnel(float ci, float eta)
-{
-    ci = ci > 1.0f ? 1.0f : (ci < -1.0f ? -1.0f : ci);
-    if (ci < 0.0f) {
-        eta = 1.0f / eta;
-        ci = -ci;
-    }
-    float s2t = (1.0f - ci * ci) / (eta * eta);
-    if (s2t >= 1.0f)
-        return 1.0f;
-    float ct = sqrtf(1.0f - s2t);
-    float rpa = (eta * ci - ct) / (eta * ci + ct), rpe = (ci - eta * ct) / (ci + eta * ct);
-    return 0.5f * (rpa * rpa + rpe * rpe);
+    sh->tint = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
 }
 
 /* Refraction of w (pointing away from the surface) through normal n with relative index eta (the side
@@ -147,37 +83,6 @@ static int refract(murk_vec3 w, murk_vec3 n, float eta, float *etap, murk_vec3 *
     *wt = murk_normalize(murk_add(murk_mul(w, -1.0f / eta), murk_mul(n, ci / eta - ct)));
     *etap = eta;
     return 1;
-}
-
-static float ggx_D(murk_vec3 m, float a2)
-{
-    float d = a2 * m.z * m.z + (m.x * m.x + m.y * m.y);
-    return a2 / (MURK_PI * d * d);
-}
-static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); } /* |mu| sqrt(1 + a2 tan^2) */
-/* G2 / (|mu_o| |mu_i|), height-correlated Smith */
-static float g2_over(float muo, float mui, float a2)
-{
-    muo = fabsf(muo);
-    mui = fabsf(mui);
-    return 2.0f / (mui * ggx_R(muo, a2) + muo * ggx_R(mui, a2));
-}
-/* G1(w) / |w.z| */
-static float g1_over(float mu, float a2)
-{
-    mu = fabsf(mu);
-    return 2.0f / (mu + ggx_R(mu, a2));
-}
-
-/* Visible GGX normal for wo with wo.z > 0, spherical caps (Dupuy & Benyoub 2023), as in ggx.c. */
-static murk_vec3 sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
-{
-    murk_vec3 ws = murk_normalize(murk_v3(alpha * wo.x, alpha * wo.y, wo.z));
-    float phi = 2.0f * MURK_PI * u0;
-    float z = (1.0f - u1) * (1.0f + ws.z) - ws.z;
-    float st = sqrtf(clamp01(1.0f - z * z));
-    murk_vec3 hs = murk_v3(st * cosf(phi) + ws.x, st * sinf(phi) + ws.y, z + ws.z);
-    return murk_normalize(murk_v3(alpha * hs.x, alpha * hs.y, murk_maxf(hs.z, 0.0f)));
 }
 
 static int usable(float z) { return fabsf(z) >= DI_MU_MIN; } /* NaN -> 0 */
@@ -215,26 +120,15 @@ typedef struct ms_at {
 static float ms_one_e(const di_ms *t, const ms_at *m, int side, float mu)
 {
     float e0 = ms_row(t, side, m->j, mu), e1 = ms_row(t, side, m->j + 1, mu);
-    return clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
+    return murk_clamp01(1.0f - (e0 + (e1 - e0) * m->fr));
 }
 
-/* The lobe (Kulla & Conty 2017's dielectric extension). Sides: o outside (index 1), i inside (index
- * eta); E_o, E_i the single-scattering energy albedos seen from each side (tables), A_s = 1 - Eavg_s their
- * averages' shortfalls, Favg = integral of F(mu, eta) 2 mu dmu from outside. For wo on side s, wi on s':
- *   reflection    f = r_s (1 - E_s(mu_o)) (1 - E_s(mu_i)) / (pi A_s)
- *   transmission  f = t_s eta_s^2 / (eta_s'^2 pi A_s') (1 - E_s(mu_o)) (1 - E_s'(mu_i)),  t_s = 1 - r_s.
- * Energy: the reflection lobe returns r_s (1 - E_s(mu_o)), the transmission lobe (its radiance albedo
- * times (eta_s' / eta_s)^2) t_s (1 - E_s(mu_o)): together exactly the single-scattering model's loss, so
- * the compensated albedo is E_s + 1 - E_s = 1 for any split. Reciprocity, f(a, b) / eta_a^2 =
- * f(b, a) / eta_b^2 (murk/material.h): reflection is symmetric; transmission needs
- * t_o / (eta^2 A_i) = t_i / A_o, i.e. t_o A_o = eta^2 t_i A_i — the transmitted compensation energy
- * crossing each way balances, as Fresnel's own 1 - Favg(1 / eta) = (1 - Favg(eta)) / eta^2 does for a
- * smooth interface. Kulla & Conty's split satisfies it with one fraction x shared by both sides:
- *   t_o = (1 - Favg) x,  t_i = (1 - Favg) (1 - x) / eta^2,  x = A_i / (A_o + A_i),
- * which is in [0, 1 - Favg] and [0, (1 - Favg) / eta^2]: both sides' shares are valid. Then
- *   transmission f = kt (1 - E_s(mu_o)) (1 - E_s'(mu_i)) / eta^2 from outside, kt (...) from inside,
- *        kt = (1 - Favg) / (pi (A_o + A_i)): f(o, i) / 1 = f(i, o) / eta^2 (reciprocal),
- *   reflection   f = kr (1 - E_s(mu_o)) (1 - E_s(mu_i)), kr = r_s / (pi A_s), r_o = 1 - t_o, r_i = 1 - t_i.
+/* The lobe (Kulla & Conty 2017's dielectric extension; derived in docs/materials.md). Sides: o outside,
+ * i inside (index eta); A_s = 1 - Eavg_s, Favg the outside's Fresnel average. For wo on side s, wi on s':
+ *   transmitted share  t_o = (1 - Favg) A_i / (A_o + A_i),  t_i = (1 - Favg) A_o / (eta^2 (A_o + A_i)),
+ *                      r_s = 1 - t_s (both sides conserve energy; transmission stays reciprocal)
+ *   reflection    f = kr (1 - E_s(mu_o)) (1 - E_s(mu_i)),  kr = r_s / (pi A_s)
+ *   transmission  f = kt (1 - E_s(mu_o)) (1 - E_s'(mu_i)) [/ eta^2 from outside],  kt = (1 - Favg) / (pi (A_o + A_i))
  * It is sampled with probability 1 - E_s(mu_o) (the energy it carries), then reflection with
  * probability r_s, else transmission, the direction cosine-weighted on that side. */
 static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float mu_o, ms_at *m)
@@ -252,7 +146,7 @@ static void ms_prepare(const di_ms *t, float alpha, float eta, int side, float m
         return;
     }
     float ts = side ? tf * ao / (eta * eta * sum) : tf * ai / sum;
-    m->r = clamp01(1.0f - ts);
+    m->r = murk_clamp01(1.0f - ts);
     m->kr = as > 1e-7f ? m->r / (MURK_PI * as) : 0.0f; /* kt alone keeps transmission reciprocal */
     m->kt = tf / (MURK_PI * sum);
 }
@@ -275,20 +169,20 @@ static int rough_one(const di_ms *ms, float eta, float alpha, murk_vec3 wo, murk
             wm = murk_neg(wm);
         float dwi = murk_dot(wm, wi), dwo = murk_dot(wm, wo);
         if (dwi * ci > 0.0f && dwo * co > 0.0f) {
-            float D = ggx_D(wm, a2);
+            float D = murk_ggx_d(wm, a2);
             /* a transmitted pair's Fresnel from the outside direction's cosine, whichever of wo and wi it
              * is: the same number as from inside, but without the cancellation in 1 - sin^2 near the
              * critical angle, so f stays reciprocal to float precision */
-            float F = fresnel(reflect || co > 0.0f ? dwo : dwi, eta);
-            float dwo_pdf = g1_over(co, a2) * D * fabsf(dwo); /* D_wo(wm) */
+            float F = murk_fresnel_dielectric(reflect || co > 0.0f ? dwo : dwi, eta);
+            float dwo_pdf = murk_ggx_vndf_pdf(wo, wm, a2); /* D_wo(wm) */
             if (reflect) {
-                *f = D * F * 0.25f * g2_over(co, ci, a2);
+                *f = D * F * 0.25f * murk_ggx_g2_over_mu2(co, ci, a2);
                 *pdf = dwo_pdf * F / (4.0f * fabsf(dwo));
             } else {
                 float s = dwi + dwo / etap, den = s * s;
                 if (den > 0.0f) {
                     float T = 1.0f - F;
-                    *f = D * T * g2_over(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
+                    *f = D * T * murk_ggx_g2_over_mu2(co, ci, a2) * fabsf(dwi * dwo) / den / (etap * etap);
                     *pdf = dwo_pdf * T * fabsf(dwi) / den;
                 }
             }
@@ -343,7 +237,7 @@ static float rough_eval(const dielectric *d, const di_shade *sh, murk_vec3 wo, m
 
 /* The compensation's tables for index eta (in [1, 4]): the rows of the two nearest eta nodes blended on
  * the aligned axis (dielectric_tables_axis.h), their exact averages, and Favg by a midpoint rule in mu^2
- * (F is smooth from outside; 4096 points: error < 1e-7). */
+ * with 4096 points (F is smooth from outside; its error: docs/results.md). */
 static void ms_build(di_ms *t, double eta)
 {
     double x = sqrt(fmax(0.0, (eta - 1.0) / 3.0)) * (DI_TAB_NETA - 1);
@@ -365,7 +259,7 @@ static void ms_build(di_ms *t, double eta)
     double sum = 0.0;
     enum { NF = 4096 };
     for (int i = 0; i < NF; i++) /* integral of F d(mu^2) */
-        sum += fresnel(sqrtf((float)((i + 0.5) / NF)), (float)eta);
+        sum += murk_fresnel_dielectric(sqrtf((float)((i + 0.5) / NF)), (float)eta);
     t->favg = (float)(sum / NF);
 }
 
@@ -398,9 +292,9 @@ static void di_destroy(void *self)
 
 /* murk's frame (+z on wo's side) to the oriented one (+z outside) and back: the model is isotropic, so
  * flipping z is all it takes. */
-static int orient(const murk_hit *hit, murk_vec3 *wo, murk_vec3 *wi)
+static int orient(const di_shade *sh, murk_vec3 *wo, murk_vec3 *wi)
 {
-    if (!murk_material_wo_inside(hit))
+    if (!sh->inside)
         return 0;
     wo->z = -wo->z;
     if (wi)
@@ -408,46 +302,51 @@ static int orient(const murk_hit *hit, murk_vec3 *wo, murk_vec3 *wi)
     return 1;
 }
 
-static murk_rgb di_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static void di_prepare(const void *self, const murk_hit *hit, murk_shading *sp)
 {
-    orient(hit, &wo, &wi);
-    di_shade sh;
-    shade_at(self, hit, &sh);
+    _Static_assert(sizeof(di_shade) <= MURK_SHADING_BYTES, "di_shade fits a murk_shading");
+    shade_at(self, hit, (di_shade *)sp->data.bytes);
+}
+
+static murk_rgb di_eval_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
+{
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    orient(sh, &wo, &wi);
     murk_rgb f;
-    rough_eval(self, &sh, wo, wi, &f);
+    rough_eval(self, sh, wo, wi, &f);
     return f;
 }
 
-static float di_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static float di_pdf_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
-    orient(hit, &wo, &wi);
-    di_shade sh;
-    shade_at(self, hit, &sh);
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    orient(sh, &wo, &wi);
     murk_rgb f;
-    return rough_eval(self, &sh, wo, wi, &f);
+    return rough_eval(self, sh, wo, wi, &f);
 }
 
-static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+static int di_sample_oriented(const dielectric *d, const di_shade *sh, murk_vec3 wo, const float u[3],
                               murk_bsdf_sample *s);
 
-static int di_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+static int di_sample_at(const void *self, const murk_shading *sp, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
 {
-    int in = orient(hit, &wo, NULL);
-    int ok = di_sample_oriented(self, hit, wo, u, s);
+    const di_shade *sh = (const di_shade *)sp->data.bytes;
+    int in = orient(sh, &wo, NULL);
+    int ok = di_sample_oriented(self, sh, wo, u, s);
     if (in)
         s->wi.z = -s->wi.z;
     return ok;
 }
 
-static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec3 wo, const float u[3],
+MURK_MATERIAL_HIT_METHODS(di)
+
+static int di_sample_oriented(const dielectric *d, const di_shade *sh, murk_vec3 wo, const float u[3],
                               murk_bsdf_sample *s)
 {
     memset(s, 0, sizeof *s);
     s->eta = 1.0f;
     if (!usable(wo.z))
         return 0;
-    di_shade sh;
-    shade_at(d, hit, &sh);
     float uc = u[2];
     int ch = 0;
     if (d->dispersive) { /* one channel's lobes, chosen uniformly; uc reused for the lobe choice */
@@ -456,8 +355,8 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
         uc = uc * 3.0f - (float)ch;
     }
     float eta = d->eta[ch];
-    if (!(sh.alpha > 0.0f)) { /* smooth: two delta lobes */
-        float R = fresnel(wo.z, eta), T = 1.0f - R;
+    if (!(sh->alpha > 0.0f)) { /* smooth: two delta lobes */
+        float R = murk_fresnel_dielectric(wo.z, eta), T = 1.0f - R;
         float w;
         if (uc < R) {
             s->wi = murk_v3(-wo.x, -wo.y, wo.z);
@@ -470,7 +369,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
                 return 0;
             s->pdf = T;
             w = T;
-            s->f = murk_rgb_scale(sh.tint, T / (etap * etap * fabsf(s->wi.z)));
+            s->f = murk_rgb_scale(sh->tint, T / (etap * etap * fabsf(s->wi.z)));
             s->eta = etap;
         }
         if (!(w > 0.0f))
@@ -486,7 +385,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     int lobe_ms = 0;
     if (d->ms) { /* the compensation lobe with probability 1 - E(mu_o) (see ms_prepare) */
         ms_at m;
-        ms_prepare(&d->tab[ch], sh.alpha, eta, wo.z < 0.0f, fabsf(wo.z), &m);
+        ms_prepare(&d->tab[ch], sh->alpha, eta, wo.z < 0.0f, fabsf(wo.z), &m);
         if (uc < m.one_eo) {
             lobe_ms = 1;
             float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1], z = sqrtf(murk_maxf(0.0f, 1.0f - u[0]));
@@ -500,10 +399,10 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     }
     if (!lobe_ms) { /* a visible normal of wo (of -wo when wo is inside), then Fresnel's choice */
         murk_vec3 wv = wo.z > 0.0f ? wo : murk_neg(wo);
-        murk_vec3 wm = sample_vndf(wv, sh.alpha, u[0], u[1]);
-        float R = fresnel(murk_dot(wo, wm), eta);
+        murk_vec3 wm = murk_ggx_sample_vndf(wv, sh->alpha, u[0], u[1]);
+        float R = murk_fresnel_dielectric(murk_dot(wo, wm), eta);
         if (uc < R) {
-            wi = murk_normalize(murk_sub(murk_mul(wm, 2.0f * murk_dot(wo, wm)), wo));
+            wi = murk_reflect(wo, wm);
             if (wi.z * wo.z <= 0.0f)
                 return 0;
         } else {
@@ -516,7 +415,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
     if (!usable(wi.z))
         return 0;
     murk_rgb f;
-    float pdf = rough_eval(d, &sh, wo, wi, &f);
+    float pdf = rough_eval(d, sh, wo, wi, &f);
     if (!(pdf > 0.0f) || !isfinite(pdf) || !murk_rgb_finite(f))
         return 0;
     s->wi = wi;
@@ -527,6 +426,7 @@ static int di_sample_oriented(const dielectric *d, const murk_hit *hit, murk_vec
 
 static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, di_create, di_destroy, di_eval, di_pdf, di_sample,
+    di_prepare, di_eval_at, di_pdf_at, di_sample_at,
 };
 
 MURK_MATERIAL_PLUGIN("dielectric",

@@ -1,11 +1,6 @@
-/* diffuse — Lambertian reflection.
- *
- * Parameters
- *   albedo  RGB in [0,1], default 0.5, texturable. Fraction of light reflected; f = albedo / pi.
- *
- * Reflection only, on whichever side wo lies (the integrator flips the frame). Sampling is
- * cosine-weighted over the hemisphere, so f cos / pdf = albedo exactly. Emission is a property of the
- * shape (`emission:` in the scene), not of the material. */
+/* diffuse — Lambertian reflection, f = albedo / pi, on whichever side wo lies (the integrator flips the
+ * frame), sampled cosine-weighted (Malley's method), so f cos / pdf = albedo exactly. Emission is a
+ * property of the shape (`emission:` in the scene), not of the material. */
 #include "murk/material.h"
 
 #include <string.h>
@@ -42,31 +37,38 @@ static void diffuse_destroy(void *self)
         d->host->free(d);
 }
 
-static murk_rgb albedo_at(const diffuse *d, const murk_hit *hit)
+/* The albedo at one hit. */
+static void diffuse_prepare(const void *self, const murk_hit *hit, murk_shading *sp)
 {
+    const diffuse *d = self;
     float a[3];
     murk_value_eval(d->host, &d->albedo, hit, a);
-    return murk_rgb3(a[0], a[1], a[2]);
+    *(murk_rgb *)sp->data.bytes = murk_rgb3(a[0], a[1], a[2]);
 }
 
-static murk_rgb diffuse_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
-{
-    if (wo.z <= 0.0f || wi.z <= 0.0f)
-        return murk_rgb1(0.0f);
-    return murk_rgb_scale(albedo_at(self, hit), MURK_INV_PI);
-}
+static murk_rgb albedo_of(const murk_shading *sp) { return *(const murk_rgb *)sp->data.bytes; }
 
-static float diffuse_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static murk_rgb diffuse_eval_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
     (void)self;
-    (void)hit;
+    if (wo.z <= 0.0f || wi.z <= 0.0f)
+        return murk_rgb1(0.0f);
+    return murk_rgb_scale(albedo_of(sp), MURK_INV_PI);
+}
+
+static float diffuse_pdf_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
+{
+    (void)self;
+    (void)sp;
     if (wo.z <= 0.0f || wi.z <= 0.0f)
         return 0.0f;
     return wi.z * MURK_INV_PI;
 }
 
-static int diffuse_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+static int diffuse_sample_at(const void *self, const murk_shading *sp, murk_vec3 wo, const float u[3],
+                             murk_bsdf_sample *s)
 {
+    (void)self;
     memset(s, 0, sizeof *s);
     if (wo.z <= 0.0f)
         return 0;
@@ -78,13 +80,15 @@ static int diffuse_sample(const void *self, const murk_hit *hit, murk_vec3 wo, c
         return 0;
     s->wi = murk_v3(x, y, z);
     s->pdf = z * MURK_INV_PI;
-    s->f = murk_rgb_scale(albedo_at(self, hit), MURK_INV_PI);
+    s->f = murk_rgb_scale(albedo_of(sp), MURK_INV_PI);
     return 1;
 }
 
+MURK_MATERIAL_HIT_METHODS(diffuse)
+
 static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, diffuse_create, diffuse_destroy, diffuse_eval, diffuse_pdf,
-    diffuse_sample,
+    diffuse_sample, diffuse_prepare, diffuse_eval_at, diffuse_pdf_at, diffuse_sample_at,
 };
 
 MURK_MATERIAL_PLUGIN("diffuse", "Lambertian diffuse reflection", params, P_COUNT, &vt)

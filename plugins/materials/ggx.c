@@ -1,77 +1,11 @@
-/* ggx — a Lambertian base under a GGX microfacet specular coat (reflection only).
- *
- * Parameters
- *   albedo     RGB in [0,1], default 0.5, texturable. Reflectance of the diffuse base: with specular 0
- *              the material is exactly Lambertian with f = albedo / pi.
- *   specular   RGB in [0,1], default 0.04, texturable. F0, the normal-incidence reflectance of the coat
- *              in Schlick's Fresnel F(c) = F0 + (1 - F0)(1 - c)^5 (0.04 ~ plastics and glass, 1 = a
- *              perfect mirror coat: no light reaches the base).
- *   roughness  float in [0,1], default 0.5, texturable. Perceptual roughness; the GGX width is
- *              alpha = roughness^2.
- *   alpha      float in [0,1], optional, texturable. The GGX width itself; when the scene gives it, it
- *              overrides roughness (alpha = value, not squared). Giving both is allowed: alpha wins and
- *              create() logs a warning.
- *   The effective alpha is clamped to [0.001, 1]: roughness 0 (or alpha 0) is a very sharp but finite
- *   GGX lobe, never a delta lobe, so eval/pdf/sample stay one smooth, MIS-able distribution.
- *   multiscatter  bool, default true. Multiple-scattering compensation of the coat (below); false gives
- *              the single-scattering model exactly as before it existed (for A/B: it loses up to 69 % of
- *              the light at roughness 1).
- *
- * Model (local shading frame, n = +z, mu = cos theta):
- *   f = f_spec + f_diff
- *   f_spec(wo,wi) = F(wo.h) D(h) V(mu_o, mu_i),  h = normalize(wo + wi)
- *     D  GGX / Trowbridge-Reitz NDF (Walter et al. 2007): alpha^2 / (pi (alpha^2 h.z^2 + h.x^2 + h.y^2)^2)
- *     V  height-correlated Smith (Heitz 2014) G2 / (4 mu_o mu_i) = 0.5 / (mu_i R(mu_o) + mu_o R(mu_i)),
- *        R(mu) = sqrt(mu^2 (1 - alpha^2) + alpha^2)
- *   f_diff(wo,wi) = albedo (1 - F0) / pi * (1 - M(mu_o)) (1 - M(mu_i)) / (1 - Mavg)
- *
- * Energy conservation (the weighting of the diffuse lobe). Let
- *   E_F(wo) = integral over visible microfacet normals of F(wo.h) D_wo(h) dh = F0 + (1 - F0) M(mu_o),
- *   M(mu) = integral of (1 - wo.h)^5 D_wo(h) dh,   D_wo = G1(wo) max(0, wo.h) D(h) / mu_o (the VNDF),
- * the fraction of the light arriving from wo that the coat's microfacets reflect (Fresnel-weighted).
- * Because the height-correlated G2 <= G1(wo), the specular lobe's directional albedo
- * E_spec(wo) = integral of f_spec cos <= E_F(wo). The diffuse lobe above is a Kelemen & Szirmay-Kalos
- * (2001) style separable, symmetric (hence reciprocal) lobe whose normalisation
- * Mavg = integral of M(mu) 2 mu dmu makes its directional albedo exactly albedo (1 - E_F(wo)). So
- *   E(wo) = E_spec(wo) + albedo (1 - E_F(wo)) <= E_F(wo) + 1 - E_F(wo) = 1
- * for every albedo, specular and roughness; with albedo 1 the only loss is the coat's
- * single-scattering shortfall E_F - E_spec (no multiple-scattering compensation). f is symmetric in
- * (wo, wi) term by term, so reciprocal. M has no closed form: it is tabulated below over
- * (t = sqrt(mu), r = sqrt(alpha)) and read bilinearly; every table entry carries a local safety margin
- * so that the interpolated M is never below the true M (checked densely by the generator), which keeps
- * the bound E <= 1 rigorous. Mavg is integrated exactly from that same interpolant. The tables are
- * in ggx_tables.h, written by tools/ggx_tables.c (see there to regenerate them).
- *
- * Multiple-scattering compensation (multiscatter: true; Kulla & Conty 2017, chosen over Turquin 2019
- * because its extra lobe is symmetric in (wo, wi), so the BSDF stays reciprocal, and is sampled exactly by
- * the cosine lobe the base already uses; Turquin's 1 + F0 (1 - E(mu_o)) / E(mu_o) scale of f_spec is not
- * reciprocal). With E(mu) the coat's single-scattering albedo for F = 1 and Eavg its cosine average,
- *   f_ms(wo,wi) = Fms (1 - E(mu_o)) (1 - E(mu_i)) / (pi (1 - Eavg)),
- *   Fms = Favg^2 Eavg / (1 - Favg (1 - Eavg)),  Favg = F0 + (1 - F0) / 21 (Schlick's average),
- * whose albedo is Fms (1 - E(mu_o)): with F0 = 1 the coat reflects E + 1 - E = 1 (the furnace). The base
- * then sits under the coat's energy bound X instead of E_F:
- *   X(mu) = F0 E(mu) + (1 - F0) M(mu) + Fms (1 - E(mu)),   f_diff = albedo (1 - X(mu_o)) (1 - X(mu_i)) / (pi (1 - Xavg)),
- * because the single-scattering albedo with Schlick's Fresnel is F0 E + (1 - F0) E5 (E5: F = (1 - c)^5)
- * and E5 <= M. So E(wo) <= X(wo) + albedo (1 - X(wo)) <= 1 again, and every term is symmetric. E is
- * tabulated (ggx_e, with safety margins so that the table is never below E: the bound stays rigorous,
- * and the compensated furnace is 1 minus at most that margin, 0.23 %) on the axis
- * w = mu (1 + alpha) / (mu + alpha), which resolves E's dip near mu ~ alpha at low alpha; Eavg
- * (ggx_eavg) is the exact average of that interpolant at 8 points per table row, interpolated between
- * (error 2.4e-6). P_spec weighs the coat's single scattering F0 E + (1 - F0) M against the compensation
- * lobe and the base together (both cosine-sampled).
- *
- * Sampling: with probability P_spec the coat (visible-normal sampling of GGX with the spherical-cap
- * method of Dupuy & Benyoub 2023, then mirror reflection), otherwise the base (cosine-weighted
- * hemisphere). P_spec = lum(E_F(wo)) / (lum(E_F(wo)) + lum(albedo (1 - E_F(wo)))), the lobes'
- * expected contributions, clamped to [0.05, 0.95] when both lobes are non-zero (exactly 1 when the base
- * is black, 0 when the coat is). pdf() is the exact mixture P_spec pdf_spec + (1 - P_spec) pdf_diff with
- * pdf_spec = D(h) G1(wo) / (4 mu_o); coat samples that reflect below the horizon are rejected (sample()
- * returns 0), so pdf() integrates to 1 minus that rejected mass.
- *
- * Robustness: wo.z or wi.z below 1e-9 (the horizon, below it, NaN) gives f = 0 and pdf = 0; sample()
- * returns 0 there and for rejected or zero-pdf samples. No formula divides by mu or tan theta alone, so
- * grazing directions (wo.z = 1e-7) stay finite, and with alpha >= 0.001 every output is bounded. */
+/* ggx — a Lambertian base under a GGX microfacet specular coat, reflection only: GGX (Walter et al.
+ * 2007) with height-correlated Smith masking-shadowing (Heitz 2014), visible-normal sampling (Heitz
+ * 2018, spherical caps: Dupuy & Benyoub 2023) and Schlick's Fresnel; an energy-conserving, reciprocal
+ * diffuse base under the coat (Kelemen & Szirmay-Kalos 2001) and multiple-scattering compensation
+ * (Kulla & Conty 2017). The model, its energy bound and its sampling are derived in docs/materials.md;
+ * the tables come from tools/ggx_tables.c. */
 #include "murk/material.h"
+#include "murk/microfacet.h"
 
 #include <string.h>
 
@@ -119,23 +53,22 @@ typedef struct ggx_shade {
     float xavg[3]; /* average of X (the coat's energy bound), per channel */
 } ggx_shade;
 
-static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; } /* NaN -> 0 */
-static int above(float z) { return z >= GGX_MU_MIN; }                                /* NaN -> 0 */
+static int above(float z) { return z >= GGX_MU_MIN; } /* NaN -> 0 */
 
 static void ggx_shade_at(const ggx *g, const murk_hit *hit, ggx_shade *sh)
 {
     float v[3];
     murk_value_eval(g->host, &g->p[P_ALBEDO], hit, v);
-    sh->albedo = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
+    sh->albedo = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
     murk_value_eval(g->host, &g->p[P_SPECULAR], hit, v);
-    sh->f0 = murk_rgb3(clamp01(v[0]), clamp01(v[1]), clamp01(v[2]));
+    sh->f0 = murk_rgb3(murk_clamp01(v[0]), murk_clamp01(v[1]), murk_clamp01(v[2]));
     float a;
     if (g->use_alpha) {
         murk_value_eval(g->host, &g->p[P_ALPHA], hit, v);
-        a = clamp01(v[0]);
+        a = murk_clamp01(v[0]);
     } else {
         murk_value_eval(g->host, &g->p[P_ROUGHNESS], hit, v);
-        float rough = clamp01(v[0]);
+        float rough = murk_clamp01(v[0]);
         a = rough * rough;
     }
     sh->alpha = a > GGX_ALPHA_MIN ? a : GGX_ALPHA_MIN;
@@ -182,13 +115,13 @@ static float tab_lookup(const float tab[GGX_TAB_N][GGX_TAB_N], float t01, float 
 }
 
 /* M(mu, alpha), mu in [0, 1], on the table's axis t = sqrt(mu). */
-static float ggx_m_lookup(const ggx_shade *sh, float mu) { return tab_lookup(ggx_m, sqrtf(clamp01(mu)), sh->r); }
+static float ggx_m_lookup(const ggx_shade *sh, float mu) { return tab_lookup(ggx_m, sqrtf(murk_clamp01(mu)), sh->r); }
 
 /* E(mu, alpha), mu in [0, 1], on the table's axis w = mu (1 + alpha) / (mu + alpha). */
 static float ggx_e_lookup(const ggx_shade *sh, float mu)
 {
-    mu = clamp01(mu);
-    return tab_lookup(ggx_e, clamp01(mu * (1.0f + sh->alpha) / (mu + sh->alpha)), sh->r);
+    mu = murk_clamp01(mu);
+    return tab_lookup(ggx_e, murk_clamp01(mu * (1.0f + sh->alpha) / (mu + sh->alpha)), sh->r);
 }
 
 /* Compensated model at one cosine: e = E(mu), and per channel the coat's energy bound
@@ -251,15 +184,6 @@ static float ggx_pspec_at(const ggx_shade *sh, float mu_o)
     return sh->ms ? ggx_pspec_ms(sh, mu_o) : ggx_pspec(sh, ggx_m_lookup(sh, mu_o));
 }
 
-static float ggx_R(float mu, float a2) { return sqrtf(mu * mu * (1.0f - a2) + a2); }
-
-/* GGX D for the unit half vector h (h.z > 0). Bounded by 1 / (pi alpha^2). */
-static float ggx_D(murk_vec3 h, float a2)
-{
-    float d = a2 * h.z * h.z + (h.x * h.x + h.y * h.y);
-    return a2 / (MURK_PI * d * d);
-}
-
 /* Unit half vector of wo and wi (both above the horizon); 0 if they are (nearly) opposite. */
 static int ggx_half(murk_vec3 wo, murk_vec3 wi, murk_vec3 *h)
 {
@@ -299,13 +223,11 @@ static murk_rgb ggx_eval_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     murk_vec3 h;
     if (ggx_half(wo, wi, &h)) {
         float a2 = sh->alpha * sh->alpha;
-        float dv = ggx_D(h, a2) * 0.5f / (mu_i * ggx_R(mu_o, a2) + mu_o * ggx_R(mu_i, a2));
-        float c = clamp01(murk_dot(wo, h));
-        float x = 1.0f - c, x2 = x * x, x5 = x2 * x2 * x;
-        for (int k = 0; k < 3; k++) {
-            float fr = sh->f0.c[k] + (1.0f - sh->f0.c[k]) * x5;
-            f.c[k] += fr * dv;
-        }
+        /* F D V, V = G2 / (4 mu_o mu_i) */
+        float dv = murk_ggx_d(h, a2) * 0.5f / murk_ggx_g2_den(mu_o, mu_i, a2);
+        float c = murk_clamp01(murk_dot(wo, h));
+        for (int k = 0; k < 3; k++)
+            f.c[k] += murk_fresnel_schlick(sh->f0.c[k], c) * dv;
     }
     return f;
 }
@@ -321,24 +243,9 @@ static float ggx_pdf_sh(const ggx_shade *sh, murk_vec3 wo, murk_vec3 wi)
     if (ps > 0.0f && ggx_half(wo, wi, &h)) {
         float a2 = sh->alpha * sh->alpha;
         /* D_wo(h) / (4 wo.h) = G1(wo) D(h) / (4 mu_o), G1 = 2 mu_o / (mu_o + R(mu_o)) */
-        pdf += ps * ggx_D(h, a2) * 0.5f / (mu_o + ggx_R(mu_o, a2));
+        pdf += ps * murk_ggx_d(h, a2) * 0.5f / (mu_o + murk_ggx_smith_r(mu_o, a2));
     }
     return pdf;
-}
-
-/* Visible GGX normal for wo (wo.z > 0), spherical caps (Dupuy & Benyoub 2023). */
-static murk_vec3 ggx_sample_vndf(murk_vec3 wo, float alpha, float u0, float u1)
-{
-    /* to the hemisphere configuration (alpha = 1) */
-    murk_vec3 ws = murk_normalize(murk_v3(alpha * wo.x, alpha * wo.y, wo.z));
-    /* uniform point on the unit sphere's cap z in (-ws.z, 1]; the half vector of it and ws is a
-     * visible normal of the hemisphere configuration */
-    float phi = 2.0f * MURK_PI * u0;
-    float z = (1.0f - u1) * (1.0f + ws.z) - ws.z;
-    float st = sqrtf(clamp01(1.0f - z * z));
-    murk_vec3 hs = murk_v3(st * cosf(phi) + ws.x, st * sinf(phi) + ws.y, z + ws.z);
-    /* back to the ellipsoid configuration */
-    return murk_normalize(murk_v3(alpha * hs.x, alpha * hs.y, fmaxf(hs.z, 0.0f)));
 }
 
 /* ---- Plugin interface ---------------------------------------------------------------------- */
@@ -366,47 +273,46 @@ static void ggx_destroy(void *self)
         g->host->free(g);
 }
 
-static murk_rgb ggx_eval(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static void ggx_prepare(const void *self, const murk_hit *hit, murk_shading *sp)
 {
-    if (!above(wo.z) || !above(wi.z))
-        return murk_rgb1(0.0f);
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    return ggx_eval_sh(&sh, wo, wi);
+    _Static_assert(sizeof(ggx_shade) <= MURK_SHADING_BYTES, "ggx_shade fits a murk_shading");
+    ggx_shade_at(self, hit, (ggx_shade *)sp->data.bytes);
 }
 
-static float ggx_pdf(const void *self, const murk_hit *hit, murk_vec3 wo, murk_vec3 wi)
+static murk_rgb ggx_eval_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
-    if (!above(wo.z) || !above(wi.z))
-        return 0.0f;
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    return ggx_pdf_sh(&sh, wo, wi);
+    (void)self;
+    return ggx_eval_sh((const ggx_shade *)sp->data.bytes, wo, wi);
 }
 
-static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+static float ggx_pdf_at(const void *self, const murk_shading *sp, murk_vec3 wo, murk_vec3 wi)
 {
+    (void)self;
+    return ggx_pdf_sh((const ggx_shade *)sp->data.bytes, wo, wi);
+}
+
+static int ggx_sample_at(const void *self, const murk_shading *sp, murk_vec3 wo, const float u[3], murk_bsdf_sample *s)
+{
+    (void)self;
+    const ggx_shade *sh = (const ggx_shade *)sp->data.bytes;
     memset(s, 0, sizeof *s);
     if (!above(wo.z))
         return 0;
-    ggx_shade sh;
-    ggx_shade_at(self, hit, &sh);
-    float ps = ggx_pspec_at(&sh, fminf(wo.z, 1.0f));
+    float ps = ggx_pspec_at(sh, fminf(wo.z, 1.0f));
     murk_vec3 wi;
     if (u[2] < ps) {
-        murk_vec3 h = ggx_sample_vndf(wo, sh.alpha, u[0], u[1]);
-        float c = murk_dot(wo, h);
-        if (!(c > 0.0f))
+        murk_vec3 h = murk_ggx_sample_vndf(wo, sh->alpha, u[0], u[1]);
+        if (!(murk_dot(wo, h) > 0.0f))
             return 0;
-        wi = murk_normalize(murk_sub(murk_mul(h, 2.0f * c), wo));
+        wi = murk_reflect(wo, h);
     } else {
         float r = sqrtf(u[0]), phi = 2.0f * MURK_PI * u[1];
         wi = murk_v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
     }
     if (!above(wi.z))
         return 0;
-    float pdf = ggx_pdf_sh(&sh, wo, wi);
-    murk_rgb f = ggx_eval_sh(&sh, wo, wi);
+    float pdf = ggx_pdf_sh(sh, wo, wi);
+    murk_rgb f = ggx_eval_sh(sh, wo, wi);
     if (!(pdf > 0.0f) || !isfinite(pdf) || !murk_rgb_finite(f))
         return 0;
     s->wi = wi;
@@ -416,8 +322,11 @@ static int ggx_sample(const void *self, const murk_hit *hit, murk_vec3 wo, const
     return 1;
 }
 
+MURK_MATERIAL_HIT_METHODS(ggx)
+
 static const murk_material_vt vt = {
     sizeof(murk_material_vt), MURK_KIND_MATERIAL, ggx_create, ggx_destroy, ggx_eval, ggx_pdf, ggx_sample,
+    ggx_prepare, ggx_eval_at, ggx_pdf_at, ggx_sample_at,
 };
 
 MURK_MATERIAL_PLUGIN("ggx", "Lambertian base under a GGX specular coat (energy-conserving, reciprocal)", params,

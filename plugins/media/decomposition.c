@@ -1,41 +1,9 @@
-/* decomposition — decomposition tracking (Kutz, Habel, Li, Novak 2017, §4): the extinction of each
- * majorant-grid cell is split into a homogeneous control part, sampled in closed form, and a residual
- * tracked with delta tracking against the residual majorant.
- *
- * Parameters
- *   control  float in [0, 10], default 1. The control density of a cell is control x the cell's
- *            minimum density (from the core's minorant grid). In [0, 1] the control never exceeds the
- *            local density, so every control collision is real and the residual is >= 0. Above 1 the
- *            control can exceed the density; with `repair` it is clamped to 1 (said once at load).
- *            0 is plain delta tracking.
- *   repair   bool, default true. false keeps a control > 1: where a residual collision finds the control
- *            above the density (negative residual) it is weighted (unbiased) and the rest of the flight
- *            is tracked with the control lowered below the density seen (murk/tracking.h's per-flight
- *            repair; noisier than the clamp) and murk says so once.
- *
- * The medium's common keys are read by the core. With stratify_flights (murk/tracking.h) the flight's
- * first draw takes the sampler slot's first coordinate — the control distance of the first cell with a
- * control, else that cell's first residual distance — and the first residual collision's real/null
- * choice its second. With sobol that first number is carried over cells as murk_collisions carries it:
- * while the process it started (control or residual) has not fired, the optical depth it has left at a
- * cell's end starts that process in the next cell where it has a rate, instead of a new number (the
- * inverse CDF of one exponential over the piecewise-constant rate: the same flight distribution, but
- * its stratification reaches past the cloud's empty border cells).
- *
- * Per cell: control density c = control x minorant, control rate c sigma_min (sigma_min: the smallest
- * channel of sigma_t, so the control never exceeds any channel's extinction), residual majorant
- * mu_r = max density x max_c sigma_t - c sigma_min. The first of a control event (real in every channel)
- * and a residual tentative event decides the flight; both processes are memoryless, so a pending control
- * distance survives a null residual event. A residual event is real with probability
- * a = (d(x) sigma_t - c sigma_min) / mu_r for grey extinction; for chromatic extinction the choice is
- * history-aware over the channels' a_c (as in delta.c) and each channel is reweighted by a_c / q (real)
- * or (1 - a_c) / (1 - q) (null). A real collision scatters with weight albedo. The real-collision rate of
- * channel c is c sigma_min + (d(x) sigma_t,c - c sigma_min) = d(x) sigma_t,c: the expected image does not
- * depend on `control` — only noise and time do. Transmittance: the control part (never above the cell's
- * minimum density) in closed form times ratio tracking of the residual. Where the majorant fails to bound (majorant_factor < 1 with
- * majorant_repair: false) or the control exceeds the density (repair: false), the violating residual
- * collision is weighted (unbiased), the rest of the flight raises the residual majorant or lowers the
- * control, and murk says so once. */
+/* decomposition — decomposition tracking (Kutz, Habel, Li, Novák 2017, "Spectral and decomposition
+ * tracking for rendering heterogeneous volumes", §4): each majorant cell's extinction is split into a
+ * homogeneous control part, sampled in closed form, and a residual delta-tracked against the residual
+ * majorant; shadow rays take the control in closed form and ratio-track the residual. The expected image
+ * does not depend on `control`, only noise and time do. Parameters: `murk plugins decomposition`; the
+ * derivation and the stratified first draw: docs/trackers.md#decomposition. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -43,10 +11,17 @@ enum { P_CONTROL, P_REPAIR, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_CONTROL] = {"control", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 10,
-                   "control density as a multiple of each majorant cell's minimum density (<= 1 stays below it)"},
+                   "the control density of a majorant cell as a multiple of the cell's minimum density (the core's "
+                   "minorant grid). In [0, 1] the control never exceeds the local density, so every control "
+                   "collision is real and the residual is >= 0. Above 1 it can exceed the density; with repair "
+                   "it is clamped to 1 (said once at load). 0 is plain delta tracking. The image does not depend "
+                   "on it, only the noise and the time do"},
     [P_REPAIR] = {"repair", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
-                  "clamp the control to each cell's minimum density (control > 1 acts as 1); false: weighted "
-                  "residual collisions and a per-flight lower control where it exceeds the density"},
+                  "true clamps a control above 1 to 1, the largest control that stays below the density "
+                  "everywhere (no bias, no extra noise). false keeps it: where a residual collision finds the "
+                  "control above the density (a negative residual) it is weighted (unbiased), the rest of the "
+                  "flight is tracked with the control lowered below the density seen (murk/tracking.h's "
+                  "per-flight repair; noisier than the clamp), and murk says so once"},
 };
 
 typedef struct decomposition {
@@ -214,7 +189,7 @@ static murk_rgb decomposition_transmittance(const void *self, const murk_ray *ra
     const decomposition *m = self;
     /* shadow rays always with the control clamped to the cell's minimum density: a control above the density
      * makes the closed-form part overshoot by exp(-(c - density) sigma L), which ratio tracking must undo
-     * with weights that grow like exp(+...) — unbiased but heavy-tailed (|z| 17 at control 10, docs/stability.md) */
+     * with weights that grow like exp(+...) — unbiased but heavy-tailed (docs/stability.md) */
     return murk_ratio_tracking(m->base.host, m->base.d, ray, murk_minf(m->control, 1.0f), rng);
 }
 

@@ -1,24 +1,8 @@
-/* delta — delta (Woodcock) tracking for free flights, residual ratio tracking for transmittance.
- *
- * Parameters: none of its own. The medium's common keys (density, sigma_a, sigma_s, scale, g,
- * majorant_factor, majorant_resolution, majorant_repair, stratify_flights) are read by the core; with
- * stratify_flights the first tentative collision's optical depth and its real/null choice come from the
- * flight's sampler slot (murk_collisions, murk/tracking.h), as in spectral, spectral_mis and naive_spectral.
- *
- * Tentative collisions are drawn with the majorant mu = max density of the grid cell x max channel of
- * sigma_t, cell by cell along the ray. A tentative collision at x is real with probability
- * sigma_t(x) / mu; a real collision scatters with weight albedo = sigma_s / sigma_t per channel
- * (absorption is folded into that weight). This is classic delta tracking when the extinction is grey.
- * With chromatic extinction there is no single collision probability: the real branch is taken with
- * probability q = sum_c |h_c| sigma_t,c(x) / sum_c |h_c| (|sigma_t,c(x)| + |mu - sigma_t,c(x)|), with h the
- * path's weight so far (history-aware, after Kutz et al. 2017, which keeps the weights bounded where a
- * plain channel average lets them grow without limit), and every channel is reweighted (real:
- * sigma_s,c(x) / (mu q), null: (mu - sigma_t,c(x)) / (mu (1 - q))) — unbiased; murk says so once. Where
- * the majorant fails to bound (majorant_factor < 1 with majorant_repair: false), the same weighted choice
- * keeps the violating collision unbiased, the rest of the flight is tracked with the majorant raised
- * (murk_collisions_raise), and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance: the
- * minorant grid as control) with Russian roulette on small
- * transmittance. */
+/* delta — delta (Woodcock) tracking for free flights (Woodcock, Murphy, Hemmings, Longworth 1965), cell by
+ * cell against the core's majorant grid; with chromatic extinction the real/null choice is history-aware
+ * and every channel reweighted (after Kutz, Habel, Li, Novák 2017: unbiased, bounded weights). Shadow
+ * rays use residual ratio tracking (Novák, Selle, Jarosz 2014; murk_tracker_transmittance). No
+ * parameters of its own (`murk plugins delta` lists the medium keys); the weights: docs/trackers.md#delta. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -76,4 +60,6 @@ static void delta_sample(const void *self, const murk_ray *ray, const murk_path_
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, delta_create, murk_tracker_free,
                                   delta_sample, murk_tracker_transmittance};
 
-MURK_MEDIUM_PLUGIN("delta", "delta tracking free flights, residual ratio tracking transmittance", NULL, 0, &vt)
+MURK_MEDIUM_PLUGIN("delta",
+                   "delta (Woodcock) tracking; residual ratio tracking for shadow rays (as every tracker by default)",
+                   NULL, 0, &vt)

@@ -1,17 +1,9 @@
-/* naive_spectral — per-channel delta tracking, the baseline spectral and MIS tracking are measured
- * against.
- *
- * Parameters: none of its own.
- *
- * Each path follows one channel, its hero h (chosen uniformly by the integrator), delta-tracked with
- * that channel's own majorant mu_h = max density of the grid cell x sigma_t,h: a tentative collision is
- * real with probability sigma_t,h(x) / mu_h and scatters with weight albedo_h. The other channels get
- * weight 0 and pdf ratio 0 (murk/medium.h), so the integrator credits the hero channel with 3x its
- * estimate: unbiased per channel, but every path carries one channel — the colour noise that spectral
- * tracking and spectral MIS remove. Where the majorant fails to bound, a weighted collision keeps it
- * unbiased, the rest of the flight is tracked with the majorant raised (murk_collisions_raise) and murk
- * says so once. Shadow rays use residual ratio tracking (every channel is estimated; only the
- * hero's carries weight in the path). */
+/* naive_spectral — per-channel delta tracking: each path delta-tracks one channel, its hero, with that
+ * channel's own majorant, and the other channels get weight 0 (the integrator credits the hero with 3x
+ * its estimate). Unbiased per channel, but every path carries one channel: the colour noise that spectral
+ * tracking (Kutz et al. 2017) and spectral MIS (Miller et al. 2019) remove, and the baseline they are
+ * measured against. Shadow rays use residual ratio tracking. No parameters of its own; details:
+ * docs/trackers.md#naive_spectral. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 

@@ -1,21 +1,8 @@
-/* spectral — spectral tracking (Kutz, Habel, Li, Novak 2017, §5): one majorant over all channels,
- * one free flight for all of them, per-channel weights.
- *
- * Parameters
- *   probabilities  enum max | average | history, default history. How the absorption, scattering and
- *                  null-collision probabilities at a tentative collision are chosen from the
- *                  per-channel coefficients sigma_x,c(x) (x = a, s, n; sigma_n,c = mu - sigma_t,c(x)):
- *                    max      P_x ~ max_c |sigma_x,c|
- *                    average  P_x ~ mean_c |sigma_x,c|
- *                    history  P_x ~ mean_c |w_c sigma_x,c| with w the path's weight so far (Kutz et al.'s
- *                             history-aware choice: keeps the weights bounded for chromatic media)
- *
- * The majorant is mu = max density of the grid cell x max channel of sigma_t. An absorption event ends
- * the path (weight 0), a scattering event weights channel c by sigma_s,c / (mu P_s), a null event by
- * sigma_n,c / (mu P_n). Unbiased for any choice of probabilities that is non-zero wherever the
- * coefficient is; where the majorant fails to bound (sigma_n < 0) the absolute values keep it so, with
- * negative weights, the rest of the flight is tracked with the majorant raised (murk_collisions_raise),
- * and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
+/* spectral — spectral tracking (Kutz, Habel, Li, Novák 2017, "Spectral and decomposition tracking for
+ * rendering heterogeneous volumes", §5): one majorant over all channels, one free flight for all of them;
+ * absorption, scattering and null collisions are chosen with probabilities built from the per-channel
+ * coefficients, and each channel is weighted by its own. Shadow rays use residual ratio tracking
+ * (murk_tracker_transmittance). Parameters: `murk plugins spectral`; the weights: docs/trackers.md#spectral. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -24,7 +11,11 @@ enum { PROB_MAX, PROB_AVERAGE, PROB_HISTORY };
 
 static const murk_param params[P_COUNT] = {
     [P_PROBABILITIES] = {"probabilities", MURK_PARAM_ENUM, 0, {0, 0, 0}, "history", "max|average|history", 0, 0,
-                         "collision-type probabilities: max, average or history-aware (Kutz et al. 2017)"},
+                         "how the absorption, scattering and null-collision probabilities P_a, P_s, P_n of a "
+                         "tentative collision are chosen from the per-channel coefficients sigma_x,c (sigma_n,c = "
+                         "majorant - sigma_t,c): max, P_x ~ max_c |sigma_x,c|; average, P_x ~ mean_c |sigma_x,c|; "
+                         "history, P_x ~ mean_c |w_c sigma_x,c| with w the path's weight so far (Kutz et al. "
+                         "2017's history-aware choice, which keeps the weights bounded in chromatic media)"},
 };
 
 typedef struct spectral {

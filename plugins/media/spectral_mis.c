@@ -1,29 +1,9 @@
-/* spectral_mis — unidirectional spectral MIS (Miller, Georgiev, Jarosz 2019).
- *
- * Parameters
- *   closed_form  bool, default false. A flight whose majorant cells all hold a constant density (max ==
- *              min: a `constant` field, or constant regions of a grid at majorant_factor 1) is sampled in
- *              closed form instead: the hero channel's own exponential, cell by cell, and each channel k
- *              weighted by its own exponential over the hero's (the balance heuristic over channels, as
- *              in Tungsten's homogeneous medium): no null collisions, no density lookups. Any other
- *              flight is tracked as below. Same expected image (tests/test_media.c); less noise per
- *              sample in homogeneous chromatic media (docs/results.md).
- *
- * Each path has a hero channel h, chosen uniformly by the integrator. Free flights are delta-tracked
- * with the hero channel's extinction against one majorant shared by all channels (mu = max density of
- * the grid cell x max channel of sigma_t): a tentative collision at x is real with probability
- * q_h = sigma_t,h(x) / mu. Because the majorant is common, the distance pdfs are equal for every channel
- * and only the event choices differ: channel k's own technique would have chosen the same event with
- * q_k (real) or 1 - q_k (null). The tracker returns
- *     weight_c = f_c / p_h   (real: sigma_s,c(x) / (mu q_h); null: (1 - sigma_t,c(x)/mu) / (1 - q_h))
- *     pdf_k    = p_k / p_h   (real: q_k / q_h;              null: (1 - q_k) / (1 - q_h))
- * and the integrator divides the path's product of weights by the mean over channels of the product
- * of pdf ratios: the balance heuristic over channels, applied to the whole path (not per segment),
- * together with NEE. A channel whose extinction differs wildly from the hero's no longer blows up the
- * weights as in per-channel delta tracking: some hero samples it well. Where the majorant fails to
- * bound, q_k = |a| / (|a| + |1 - a|) keeps every technique valid (weighted, unbiased), the rest of the
- * flight is tracked with the majorant raised (murk_collisions_raise: the same raise for every channel's
- * technique, so the distance pdfs stay equal) and murk says so once. Shadow rays use residual ratio tracking (murk_tracker_transmittance). */
+/* spectral_mis — unidirectional spectral MIS (Miller, Georgiev, Jarosz 2019, "A null-scattering path
+ * integral formulation of light transport"): a path delta-tracks its hero channel against one majorant
+ * shared by all channels and returns per-channel weights and pdf ratios, with which the integrator
+ * combines the channels' techniques by the balance heuristic over the whole path. Shadow rays use
+ * residual ratio tracking (murk_tracker_transmittance). Parameters: `murk plugins spectral_mis`; the
+ * weights and the closed-form flights: docs/trackers.md#spectral_mis. */
 #include "murk/medium.h"
 #include "murk/tracking.h"
 
@@ -31,7 +11,13 @@ enum { P_CLOSED_FORM, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_CLOSED_FORM] = {"closed_form", MURK_PARAM_BOOL, 0, {0, 0, 0}, NULL, NULL, 0, 1,
-                       "flights through constant-density cells: the hero channel's exponential in closed form"},
+                       "a flight through majorant cells of constant density (max = min: a constant field, or "
+                       "constant regions of a grid at majorant_factor 1) is sampled in closed form: the hero "
+                       "channel's own exponential, cell by cell, each channel weighted by its own exponential over "
+                       "the hero's (the balance heuristic over channels, as in Tungsten's homogeneous medium): no "
+                       "null collisions, no density lookups. From the first cell that is not constant the flight "
+                       "is tracked as usual. The same expected image (tests/test_media.c); less noise per sample "
+                       "in homogeneous chromatic media (docs/results.md)"},
 };
 
 typedef struct smis {
@@ -147,5 +133,6 @@ static void smis_sample(const void *self, const murk_ray *ray, const murk_path_c
 static const murk_medium_vt vt = {sizeof(murk_medium_vt), MURK_KIND_MEDIUM, smis_create, murk_tracker_free,
                                   smis_sample, murk_tracker_transmittance};
 
-MURK_MEDIUM_PLUGIN("spectral_mis", "spectral MIS (Miller et al. 2019): hero-channel tracking, balance heuristic over channels",
+MURK_MEDIUM_PLUGIN("spectral_mis",
+                   "spectral MIS (Miller et al. 2019): hero-channel tracking, balance heuristic over channels",
                    params, P_COUNT, &vt)

@@ -1,45 +1,10 @@
 /* power_series — a cumulative power-series transmittance estimator after Georgiev, Misso, Hachisuka,
- * Nowrouzezahrai, Krivanek, Jarosz 2019 ("Integral formulations of volumetric transmittance"): the
+ * Nowrouzezahrai, Křivánek, Jarosz 2019 ("Integral formulations of volumetric transmittance"): the
  * majorant as the control, every term up to the order evaluated, the order at least the point where the
  * Poisson CMF of the majorant's optical depth reaches 1 - 1e-8 and beyond it the Poisson count (their
- * "p-series CMF"; the single top term alone would be ratio tracking).
- *
- * Parameters
- *   chunk_depth  float in [0.25, 32], default 4. The ray is cut into chunks of about this majorant
- *                optical depth (consecutive majorant cells, long cells split); each chunk gets its own
- *                series and the chunks' estimates multiply (independent, so still unbiased). Keeps the
- *                Poisson weights well-conditioned and lets Russian roulette stop opaque rays early.
- *
- * Estimator, per chunk with majorant rate mu(t) = dmax(t) x max_c sigma_t,c and optical depth
- * tau_bar = int mu. The points x_1..x_K of a Poisson process of rate mu (K ~ Poisson(tau_bar); given K the
- * points are i.i.d. with density mu / tau_bar), topped up with more i.i.d. points of that density to
- * N = max(K, k0), k0 the smallest order with P(K <= k0) >= 1 - 1e-8, give y_i,c = 1 - sigma_t,c(x_i) /
- * mu(x_i), each unbiased for (tau_bar - tau_c) / tau_bar. With m_k,c the elementary symmetric mean of
- * order k of the y_i,c (unbiased for ((tau_bar - tau_c) / tau_bar)^k given N >= k, and symmetric: the
- * points may come in sorted order) and P(N >= k) = 1 up to k0, the Poisson tail P(K >= k) above,
- *     T_c = sum_{k=0}^{N} Pois(k; tau_bar) m_k,c / P(N >= k)
- * has expectation sum_k e^-tau_bar (tau_bar - tau_c)^k / k! = exp(-tau_c): unbiased per channel, for any
- * majorant (where the density exceeds it y < 0 and the terms alternate; the core warns at load). With a
- * tight majorant on constant density (y = 0) T = e^-tau_bar exactly: zero variance.
- *
- * Why k0 (issue 9): with the order the bare Poisson count (N = K), a chunk where the density is far below
- * the majorant (y ~ 1, e.g. a shadow ray leaving a dense cloud through the empty part of a dense majorant
- * cell) gives sum_{k<=K} Pois(k) / P(K >= k), between 0.09 and 1.8 at tau_bar 4, instead of ~1; the
- * chunks multiply, so the variance grows like exp(c x the loose majorant depth) and at density 1e4 the
- * product was almost always ~0 (the cloud's lit top 5% dark in the stability atlas). With k0 a chunk's
- * estimate is the full series but for a Poisson tail of 1e-8: bounded variance (that tail, weights ~1, is
- * paid in rare jumps; at 1e-5 the typical estimate of a dense ray's hundreds of chunks was visibly short).
- * A second, rarer fault (found by reading): a chunk's cut that rounded down to a float could leave a room
- * below half a float step; the next cut could not advance and the rest of the majorant cell ran into that
- * chunk (ratio-tracked; past 1024 points, stopped at 0). Such a chunk now counts as full, and a ratio-
- * tracked chunk has no point cap.
- * Cost: per chunk about max(K, k0) lookups (k0 = 20 at tau_bar 4, 68 at 32: the deeper chunks cost
- * fewer lookups per optical depth) plus O(N^2) arithmetic. Every point (Poisson, top-up or ratio-tracked)
- * is one density lookup and one tentative collision in the cost counters (murk/counters.h), so in
- * bench.csv its collisions equal its lookups. Russian roulette between chunks (survival =
- * the largest channel, once below 0.1), as ratio tracking. A chunk whose tau_bar exceeds 64 (one float
- * step of t holding a deep majorant) is ratio-tracked instead (unbiased); one with more than 1024 points
- * stops with a warning (biased; at tau_bar <= 64 never seen). */
+ * "p-series CMF"), on chunks of the ray whose estimates multiply. Unbiased per channel for any majorant;
+ * zero variance on a constant density with a tight majorant. Parameters: `murk plugins power_series`; the
+ * estimator, why the order is topped up, and its cost: docs/trackers.md#power_series. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 
@@ -47,7 +12,10 @@ enum { P_CHUNK_DEPTH, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_CHUNK_DEPTH] = {"chunk_depth", MURK_PARAM_FLOAT, 0, {4, 0, 0}, NULL, NULL, 0.25, 32,
-                       "majorant optical depth per independent power-series chunk"},
+                       "the majorant optical depth of a chunk: the ray is cut into chunks of about this depth "
+                       "(consecutive majorant cells, long cells split), each gets its own series and the chunks' "
+                       "estimates multiply (independent, so still unbiased). Keeps the Poisson weights "
+                       "well-conditioned and lets Russian roulette stop opaque rays early"},
 };
 
 enum { MAX_PIECES = 64, MAX_POINTS = 1024 };
@@ -259,5 +227,6 @@ static const murk_transmittance_vt vt = {sizeof(murk_transmittance_vt), MURK_KIN
                                          murk_tracker_free, ps_estimate};
 
 MURK_TRANSMITTANCE_PLUGIN("power_series",
-                          "cumulative power-series estimator (after Georgiev et al. 2019): majorant control, Poisson order",
+                          "cumulative power series (after Georgiev et al. 2019): majorant control, Poisson order "
+                          "topped up to its 1 - 1e-8 CMF (bounded variance)",
                           params, P_COUNT, &vt)

@@ -1,15 +1,8 @@
-/* ratio — ratio tracking (Novak, Selle, Jarosz 2014) with the core's majorant grid.
- *
- * Parameters: none of its own.
- *
- * Tentative collisions are drawn cell by cell along the ray with rate mu = (the cell's maximum density)
- * x (the largest channel of sigma_t); each multiplies channel c's estimate by 1 - sigma_t,c(x) / mu.
- * Unbiased for any mu > 0: where the density exceeds the majorant (majorant_factor < 1) the factor goes
- * negative and the estimate stays unbiased (the core warns at load). Russian roulette on small
- * transmittance (survival probability = the largest channel, once below 0.1) keeps dense shadow rays
- * short without bias. Every channel shares the collisions and is weighted by its own extinction, so the
- * estimate is unbiased per channel for any hero (murk/transmittance.h). This is what every tracker's
- * own transmittance() does without a control (murk_ratio_tracking in murk/tracking.h). */
+/* ratio — ratio tracking (Novák, Selle, Jarosz 2014, "Residual ratio tracking for estimating attenuation
+ * in participating media") against the core's majorant grid: every tentative collision multiplies each
+ * channel's estimate by its null-collision fraction, with Russian roulette on small transmittance. What
+ * every tracker's own transmittance() does without a control (murk_ratio_tracking, murk/tracking.h). No
+ * parameters of its own; details: docs/trackers.md#ratio. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 

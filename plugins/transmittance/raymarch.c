@@ -1,19 +1,8 @@
 /* raymarch — BIASED BY DESIGN: classic ray marching, T_c = exp(-sigma_t,c D^) with D^ a fixed-step
  * estimate of the density integral. A baseline for the unbiased estimators: its error does not vanish
- * with more samples, only with a smaller step. murk logs a one-line notice when a scene uses it.
- *
- * Parameters
- *   step    float in [1e-4, 100], default 0.05 (world units). Each majorant cell crossed is marched in
- *           ceil(length / step) equal steps (cells whose majorant is 0 are skipped: no lookups, and
- *           infinite rays end at the field's box).
- *   jitter  bool, default true. true: one uniform offset per march (D^ is then unbiased for D, but
- *           exp(-sigma D^) is not unbiased for exp(-sigma D): by Jensen's inequality it is biased upwards,
- *           by about sigma^2 Var(D^) / 2 x T); false: the deterministic midpoint rule (biased by its
- *           quadrature error; aliasing on grids).
- *
- * The bias shrinks as step shrinks (measured in tests/test_transmittance.c and docs/results.md) and is
- * never zero on a heterogeneous medium. On a density that is constant along every step both variants are
- * exact. Per channel: one march shared by all channels, exp(-sigma_t,c D^) per channel. */
+ * with more samples, only with a smaller step, and is never zero on a heterogeneous medium. murk logs a
+ * one-line notice when a scene uses it. Parameters: `murk plugins raymarch`; the bias:
+ * docs/trackers.md#raymarch. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 
@@ -21,9 +10,14 @@ enum { P_STEP, P_JITTER, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_STEP] = {"step", MURK_PARAM_FLOAT, 0, {0.05, 0, 0}, NULL, NULL, 1e-4, 100,
-                "ray-marching step in world units (BIASED: the error shrinks with the step, never to 0)"},
+                "the ray-marching step in world units: each majorant cell crossed is marched in ceil(length / "
+                "step) equal steps (cells whose majorant is 0 are skipped: no lookups, and infinite rays end at "
+                "the field's box). BIASED: the error shrinks with the step (tests/test_transmittance.c, "
+                "docs/results.md), never to 0 on a heterogeneous medium"},
     [P_JITTER] = {"jitter", MURK_PARAM_BOOL, 0, {1, 0, 0}, NULL, NULL, 0, 1,
-                  "one random offset per march (else the fixed midpoint rule)"},
+                  "true: one uniform offset per march, so the density integral is unbiased but its exponential "
+                  "is not (by Jensen's inequality it is biased upwards, by about sigma^2 Var / 2 x T); false: the "
+                  "deterministic midpoint rule, biased by its quadrature error (and aliasing on grids)"},
 };
 
 typedef struct raymarch {

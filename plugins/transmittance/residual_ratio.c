@@ -1,20 +1,8 @@
-/* residual_ratio — residual ratio tracking (Novak, Selle, Jarosz 2014) with the core's minorant grid as
- * the control.
- *
- * Parameters
- *   control  float in [0, 10], default 1. The control density of a majorant-grid cell is control x the
- *            cell's minimum density (the minorant grid). Its optical depth is taken in closed form,
- *            exp(-c sigma_t,c L) per cell and channel; only the residual density(x) - c is ratio-tracked,
- *            against the residual majorant |max density - c|. In [0, 1] the control never exceeds the
- *            density; above 1 the residual goes negative where the control does not bound, the
- *            ratio-tracking factors 1 - residual sigma / mu exceed 1 and the estimate stays unbiased
- *            (noisier; murk says so at load). 0 is plain ratio tracking.
- *
- * The same computation as decomposition tracking's transmittance() (murk_ratio_tracking with a control,
- * murk/tracking.h), with Russian roulette on small transmittance. In cells of constant density with an
- * exact minorant the residual is 0: those cells cost no lookups and add no variance. Unbiased per
- * channel for any hero: the control and the collisions are shared, each channel weighted by its own
- * extinction. */
+/* residual_ratio — residual ratio tracking (Novák, Selle, Jarosz 2014, "Residual ratio tracking for
+ * estimating attenuation in participating media") with the core's minorant grid as the control: the
+ * control's optical depth in closed form, the residual ratio-tracked. The same computation as a tracker's
+ * own transmittance() (murk_ratio_tracking with a control, murk/tracking.h). Parameters: `murk plugins
+ * residual_ratio`; details: docs/trackers.md#residual_ratio. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 
@@ -22,7 +10,12 @@ enum { P_CONTROL, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_CONTROL] = {"control", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 10,
-                   "control density as a multiple of each majorant cell's minimum density (<= 1 stays below it)"},
+                   "the control density of a majorant cell as a multiple of the cell's minimum density (the "
+                   "minorant grid); its optical depth is taken in closed form, exp(-c sigma_t L) per cell and "
+                   "channel, and only the residual density - c is ratio-tracked, against the residual majorant "
+                   "|max density - c|. In [0, 1] the control never exceeds the density; above 1 the residual goes "
+                   "negative where the control does not bound, and the estimate stays unbiased but noisier (murk "
+                   "says so at load). 0 is plain ratio tracking"},
 };
 
 typedef struct residual {
@@ -56,5 +49,6 @@ static const murk_transmittance_vt vt = {sizeof(murk_transmittance_vt), MURK_KIN
                                          murk_tracker_free, residual_estimate};
 
 MURK_TRANSMITTANCE_PLUGIN("residual_ratio",
-                          "residual ratio tracking (Novak et al. 2014): minorant control in closed form + ratio-tracked residual",
+                          "residual ratio tracking (Novak et al. 2014): minorant control in closed form + "
+                          "ratio-tracked residual",
                           params, P_COUNT, &vt)

@@ -1,16 +1,8 @@
 /* track_length — the track-length (delta-tracking) transmittance estimator: 1 if a free flight passes
- * the segment, 0 if it collides. The high-variance baseline (Var = T (1 - T), the largest of murk's
- * unbiased estimators).
- *
- * Parameters: none of its own.
- *
- * Tentative collisions are drawn cell by cell with rate mu = (the cell's maximum density) x (the
- * largest channel of sigma_t). At each, one uniform u is drawn and channel c collides (its estimate
- * becomes 0) if u < a_c = sigma_t,c(x) / mu: the same free flight for every channel (common random
- * numbers), each channel a binary delta-tracking estimate of its own transmittance — unbiased per
- * channel for any hero. The walk stops when every channel has collided. Where the majorant fails to
- * bound (a_c > 1, majorant_factor < 1) that channel is multiplied by 1 - a_c instead (a ratio-tracking
- * step, the same conditional expectation: still unbiased, no longer binary) and murk says so once. */
+ * the segment, 0 if it collides, one flight for every channel (common random numbers). The high-variance
+ * baseline (Var = T (1 - T), the largest of murk's unbiased estimators; ratio tracking, Novák, Selle,
+ * Jarosz 2014, is its conditional expectation). No parameters of its own; details:
+ * docs/trackers.md#track_length. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 

@@ -1,31 +1,9 @@
-/* unbiased_raymarch — unbiased ray marching after Kettunen, d'Eon, Pantaleoni, Novak 2021: a ray-marched
- * control optical depth, corrected by a power series whose terms are products of independent ray-marched
- * estimates, with aggressive Russian roulette. Zero variance where the extinction is constant.
- *
- * Parameters
- *   depth_step  float in [0.05, 16], default 1. Majorant optical depth per ray-march step: a majorant
- *               cell crossed over length L with maximum density dmax gets ceil(dmax max_c sigma_t,c L /
- *               depth_step) equal steps (at least one; cells with dmax 0 none). Smaller: more lookups
- *               per march, a better control and smaller corrections.
- *   order       int in [1, 16], default 1. Correction terms always evaluated; term k > order is
- *               evaluated with probability min(1, max_c sigma_t,c |X_{k-1}| / k) (Russian roulette
- *               that follows the series' own decay) and divided by it.
- *   roulette    float in [0, 1], default 0.1. When the control's transmittance (largest channel) is below
- *               this, the whole estimate survives with probability exp(-control) / roulette and is
- *               divided by it (0: never): opaque shadow rays skip the correction marches.
- *
- * Estimator. Let D = int density (so tau_c = sigma_t,c D), Dc one jittered ray march of D (murk_march_depth
- * with a uniform offset: unbiased for D) — the control — and D_1, D_2, ... further independent jittered
- * marches. With X_i = Dc - D_i (unbiased for Dc - D given Dc),
- *     T_c = exp(-sigma_t,c Dc) sum_k prod_{i<=k} (sigma_t,c X_i) / (k! P(term k evaluated))
- * has expectation exp(-sigma_t,c Dc) exp(sigma_t,c (Dc - D)) = exp(-tau_c) for any control independent
- * of the X_i (here: given Dc, the X_i are independent), so it is unbiased per channel. Where the density
- * is constant over each step every march returns the same D exactly, X_i = 0 and T = exp(-tau) with zero
- * variance. Terms may be negative (X_i of either sign): the estimate can be negative, unbiased by
- * design. Kettunen et al. draw the control and all terms from one batch of marches with elementary
- * means and pick the march resolution and order from the majorant; this is the simpler variant with one
- * control march and one march per term, which the tests verify. Cost: (1 + ~order) marches per estimate.
- * Unbiased for any majorant (the majorant only sets the step count); independent of the hero. */
+/* unbiased_raymarch — unbiased ray marching after Kettunen, d'Eon, Pantaleoni, Novák 2021 ("An unbiased
+ * ray-marching transmittance estimator"): a jittered ray-marched control optical depth, corrected by a
+ * power series whose terms are products of independent ray-marched estimates, with aggressive Russian
+ * roulette. Unbiased per channel (an estimate may be negative, by design); zero variance where the
+ * extinction is constant. Parameters: `murk plugins unbiased_raymarch`; the estimator and how it differs
+ * from the paper's: docs/trackers.md#unbiased_raymarch. */
 #include "murk/transmittance.h"
 #include "murk/tracking.h"
 
@@ -33,11 +11,18 @@ enum { P_DEPTH_STEP, P_ORDER, P_ROULETTE, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
     [P_DEPTH_STEP] = {"depth_step", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0.05, 16,
-                      "majorant optical depth per ray-march step (smaller: finer marches)"},
+                      "the majorant optical depth of a ray-march step: a majorant cell crossed over length L with "
+                      "maximum density dmax gets ceil(dmax max_c sigma_t,c L / depth_step) equal steps (at least "
+                      "one; cells with dmax 0 none). Smaller: more lookups per march, a better control and "
+                      "smaller corrections"},
     [P_ORDER] = {"order", MURK_PARAM_INT, 0, {1, 0, 0}, NULL, NULL, 1, 16,
-                 "power-series terms always evaluated (later ones under Russian roulette)"},
+                 "the correction terms always evaluated; term k > order is evaluated with probability min(1, "
+                 "max_c sigma_t,c |X_{k-1}| / k) (Russian roulette that follows the series' own decay) and "
+                 "divided by it. Cost: about 1 + order ray marches per estimate"},
     [P_ROULETTE] = {"roulette", MURK_PARAM_FLOAT, 0, {0.1, 0, 0}, NULL, NULL, 0, 1,
-                    "control transmittance below which the whole estimate is Russian-rouletted (0: never)"},
+                    "when the control's transmittance (its largest channel) is below this, the whole estimate "
+                    "survives with probability exp(-control) / roulette and is divided by it (0: never): opaque "
+                    "shadow rays skip the correction marches"},
 };
 
 typedef struct urm {
@@ -115,5 +100,6 @@ static const murk_transmittance_vt vt = {sizeof(murk_transmittance_vt), MURK_KIN
                                          murk_tracker_free, urm_estimate};
 
 MURK_TRANSMITTANCE_PLUGIN("unbiased_raymarch",
-                          "unbiased ray marching (Kettunen et al. 2021): ray-marched control + power-series correction",
+                          "unbiased ray marching (Kettunen et al. 2021): ray-marched control + power-series "
+                          "correction; zero variance where the density is constant",
                           params, P_COUNT, &vt)

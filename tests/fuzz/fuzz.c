@@ -7,11 +7,12 @@
  *   exr    EXR reading, as `murk compare` does it
  * The readers take paths, so each input is written to a scratch file first. Plugins are built with the
  * same instrumentation (meson's -Dfuzz=enabled applies it project-wide). */
-#include "density.h"
-#include "image.h"
+#include "media/density.h"
+#include "image/image.h"
 #include "murk/murk.h"
-#include "obj.h"
-#include "util.h"
+#include "scene/obj.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include <stdint.h>
 #include <stdio.h>

@@ -26,7 +26,11 @@
  * (the hit a material gets has n on wo's side, murk/material.h); 1.4 appends murk_host.counters (the
  * cost counters, murk/counters.h), the sampler to murk_rng (murk_sample_1d/2d, murk/math.h) and the
  * host's sample_light_with / light_pdf_with; 1.5 appends murk_medium_data.stratify_flights (murk/medium.h);
- * 1.6 appends murk_host.boundaries.
+ * 1.6 appends murk_host.boundaries; 1.7 appends the material's prepare() and prepared eval/pdf/sample
+ * (textures read once per vertex, murk/material.h).
+ * 1.8 (MURK_ABI_MINOR_LIGHTS) lets a light sample be at infinity
+ * (dist = INFINITY) or of a delta light (murk_light_sample.flags, appended), and appends
+ * murk_host.environment_pdf: escaped rays are MIS-weighted against the environment's light sampling.
  * Anything else — a changed signature,
  * a removed or reordered field — bumps the major, and the host refuses plugins of another major.
  *
@@ -58,7 +62,10 @@
 #include "murk/math.h"
 
 #define MURK_ABI_MAJOR 1
-#define MURK_ABI_MINOR 6
+#define MURK_ABI_MINOR 8
+/* The minor that brought infinite and delta light samples: an integrator built before it never gets one
+ * (the core keeps such lights out of its light sampling and refuses a scene with delta lights for it). */
+#define MURK_ABI_MINOR_LIGHTS 8
 
 /* The iteration cap of the watchdog contract above (2^24): far above what a valid scene needs — murk
  * refuses media whose optical depth exceeds 1e6 — and small enough that a stuck call ends in well
@@ -103,7 +110,8 @@ typedef struct murk_param {
     const char *def_str; /* default for STRING and ENUM */
     const char *choices; /* ENUM only: "max|average|history" */
     double min, max;  /* inclusive range for numbers and every RGB component */
-    const char *doc;  /* one line, shown by `murk plugins NAME` */
+    const char *doc;  /* the parameter's description, one paragraph without line breaks (any length:
+                       * `murk plugins NAME` wraps it; `--markdown` puts it in a table cell) */
 } murk_param;
 
 typedef struct murk_texture murk_texture; /* opaque; evaluated through murk_host.tex_eval */
@@ -140,10 +148,21 @@ typedef struct murk_hit {
 
 typedef struct murk_light_sample {
     murk_vec3 wi;  /* unit direction from the shading point to the light point */
-    float dist;    /* distance to the light point */
-    murk_rgb le;   /* emitted radiance towards the shading point */
-    float pdf;     /* solid-angle pdf, light selection included; 0 = no sample */
+    float dist;    /* distance to the light point; INFINITY (ABI 1.7) for a light at infinity (a distant
+                    * light, the environment): the shadow ray runs to infinity along wi */
+    murk_rgb le;   /* emitted radiance towards the shading point (a delta light: its irradiance there) */
+    float pdf;     /* solid-angle pdf, light selection included; 0 = no sample (a delta light: the
+                    * probability of choosing it) */
+    /* ABI 1.7: MURK_LIGHT_SAMPLE_* bits. The host writes it only for integrators of ABI >= 1.7 (older
+     * ones never get a delta or infinite sample): an integrator sets it to 0 before asking. */
+    uint32_t flags;
 } murk_light_sample;
+
+/* murk_light_sample.flags (ABI 1.7). DELTA: a point, spot or delta distant light, which no BSDF or
+ * phase sample can hit: f le T / pdf counts with MIS weight 1. */
+#define MURK_LIGHT_SAMPLE_DELTA 1u
+/* The size of murk_light_sample before ABI 1.7 (what an older integrator's stack holds). */
+#define MURK_LIGHT_SAMPLE_SIZE_1_6 (offsetof(murk_light_sample, pdf) + sizeof(float))
 
 /* ---- Host services (the only way a plugin reaches the core) -------------------------------- */
 enum { MURK_LOG_INFO = 0, MURK_LOG_WARN = 1 };
@@ -160,10 +179,12 @@ typedef struct murk_host {
      * (ray.tmin, ray.tmax); occluded() returns 1 if any surface lies there (boundaries included). */
     int (*intersect)(const murk_scene *scene, const murk_ray *ray, murk_hit *hit);
     int (*occluded)(const murk_scene *scene, const murk_ray *ray);
-    /* Pick an emissive shape (by power) and a point on it as seen from p; u are three uniforms. */
+    /* Pick a light (by power: emissive shapes and, for integrators of ABI >= 1.7, the scene's `lights:`)
+     * and a point on it as seen from p; u are three uniforms. */
     int (*sample_light)(const murk_scene *scene, murk_vec3 p, const float u[3], murk_light_sample *ls);
     /* The solid-angle pdf with which sample_light(p) would have produced the emissive hit. */
     float (*light_pdf)(const murk_scene *scene, murk_vec3 p, const murk_hit *hit);
+    /* The radiance of the environment towards -dir (what a ray leaving the scene along dir sees). */
     murk_rgb (*background)(const murk_scene *scene, murk_vec3 dir);
     const murk_medium *(*camera_medium)(const murk_scene *scene);
     /* Media (murk/medium.h). density() is the field at a world point; walk_init/walk_next step
@@ -190,6 +211,12 @@ typedef struct murk_host {
      * every surface occluded() can find has a material: a shadow ray it reports blocked is blocked,
      * with no intersect() to tell a boundary from an occluder. */
     size_t (*boundaries)(const murk_scene *scene);
+    /* ABI 1.7: the solid-angle pdf with which sample_light_with would have sampled direction dir of the
+     * environment (background(), which holds the whole environment: the constant background, environment
+     * maps, the sky, finite-cone distant lights). 0 where no part of it is sampled (a scene with only a
+     * constant background: escaped rays count fully, as before). An escaped ray after a BSDF / phase
+     * sample of pdf p adds background(dir) x power_heuristic(p, environment_pdf(dir)). */
+    float (*environment_pdf)(const murk_scene *scene, murk_vec3 dir);
 } murk_host;
 
 /* Light sampling strategies (ABI 1.4). AREA: a triangle uniformly by area (a rectangular quad or box

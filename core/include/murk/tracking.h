@@ -88,8 +88,8 @@ static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-m
  * collision loop's unbounded use never moves the integrator's slots. With render.sampler sobol the slot
  * is a 2-D point, stratified over the pixel's samples: its first coordinate gives the flight's first
  * distance, its second the choice (real or null, absorbed or scattered) at the flight's first
- * collision — jointly stratified, which measured far better on chromatic media than the distance alone
- * (docs/results.md). It changes which numbers a flight uses, never its method or its distribution.
+ * collision, jointly stratified (docs/results.md, "Stratified free flights", compares it with the
+ * distance alone). It changes which numbers a flight uses, never its method or its distribution.
  * With render.sampler independent murk_sample_1d is murk_rng_float in call order and the choice's
  * number is drawn where it always was: the numbers are those of an unstratified flight. A tracker keeps
  * `int first = murk_flight_stratified(d); float uc = -1;` per flight and draws with murk_flight_float /
@@ -199,8 +199,8 @@ static inline float murk_collision_prob(const murk_tracker *t, const float a[3],
  * majorant after a collision may depend on everything sampled before it. It is per path, from the
  * path's own random numbers: the image stays a pure function of (scene, seed, spp) for any thread
  * count and tiling, which a majorant shared and raised between threads at run time would break. Without
- * the raise a weight of 2a - 1 multiplies at EVERY violating collision (relMSE 1e19 on cornell_smoke at
- * majorant_factor 0.5); with it about one collision per flight is weighted. Each flight starts again
+ * the raise a weight of 2a - 1 multiplies at EVERY violating collision (docs/stability.md has what that
+ * did to cornell_smoke); with it about one collision per flight is weighted. Each flight starts again
  * from the grid's majorant (a path has no state of its own), which is why the core's repair, not this
  * one, is the default. */
 #define MURK_MAJORANT_RAISE 2.0f
@@ -428,10 +428,9 @@ static inline double murk_march_depth(const murk_host *h, const murk_medium_data
 /* The transmittance() of a tracker whose struct starts with a murk_tracker — what a medium's shadow
  * rays use when the scene names no estimator: residual ratio tracking with each majorant cell's
  * minimum density as the control (the `residual_ratio` estimator's default), exact (zero variance)
- * where the density is constant over a cell. It measured 1.2-2.2x plain ratio tracking's efficiency
- * in density lookups (docs/results.md) and never returns a negative estimate while the majorant
- * bounds; `unbiased_raymarch` measured better still but may return negative estimates, so it is
- * opt-in. */
+ * where the density is constant over a cell, and never negative while the majorant bounds: which is
+ * why it, and not `unbiased_raymarch` (whose estimates may be negative), is the default. docs/results.md
+ * ("The default") compares their efficiency with plain ratio tracking's. */
 static inline murk_rgb murk_tracker_transmittance(const void *self, const murk_ray *ray, const murk_path_ctx *ctx,
                                                   murk_rng *rng)
 {

@@ -6,7 +6,7 @@
 #include <stddef.h>
 
 #include "murk/math.h"
-#include "yamldoc.h"
+#include "yaml/yamldoc.h"
 
 int murk_yread_number(const murk_ynode *n, const char *what, double *out, char *err, size_t errlen);
 int murk_yread_range(const murk_ynode *n, const char *what, double lo, double hi, double *out, char *err,

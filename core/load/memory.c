@@ -1,11 +1,12 @@
 /* memory.c — what a loaded scene holds in memory, item by item (scene.h, murk_scene_memory): for `murk info`
  * and the end-of-render summary, so that a scene's memory can be read off what it names. Bytes are counted
  * as allocated (element counts times sizes), without the allocator's overhead; the process's peak resident
- * memory (VmHWM) is given beside them for what they leave out (libraries, the render's buffers). */
-#include "scene/scene.h"
+ * memory (VmHWM, murk_peak_rss_kb) is given beside them for what they leave out (libraries, the render's
+ * buffers). */
+#include "load/load.h"
 #include "media/density.h"
 #include "media/media.h"
-#include "render/texture.h"
+#include "scene/texture.h"
 #include "util/util.h"
 
 #include <stdio.h>
@@ -71,17 +72,4 @@ MURK_API size_t murk_scene_memory(const murk_scene *s, murk_mem_item *items, siz
     long long eb = __atomic_load_n(&s->embree_bytes, __ATOMIC_RELAXED);
     it->bytes = eb > 0 ? (uint64_t)eb : 0;
     return n;
-}
-
-MURK_API long murk_peak_rss_kb(void)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    long kb = -1;
-    while (f && fgets(line, sizeof line, f))
-        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
-            break;
-    if (f)
-        fclose(f);
-    return kb;
 }

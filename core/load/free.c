@@ -1,8 +1,10 @@
-/* scene.c — the scene data: what a loaded scene owns and how it is released (load.c builds it). */
-#include "scene.h"
-#include "media.h"
-#include "texture.h"
-#include "util.h"
+/* free.c — what a loaded scene owns and how it is released: murk_scene_free, the inverse of load.c's
+ * murk_scene_load (the scene's data, scene.h, sits below the media and render parts it frees). */
+#include "load/load.h"
+#include "media/media.h"
+#include "render/envmap.h"
+#include "scene/texture.h"
+#include "util/util.h"
 
 #include <stdlib.h>
 
@@ -43,6 +45,11 @@ MURK_API void murk_scene_free(murk_scene *s)
     free(s->param_store);
     free(s->lights);
     free(s->light_cdf);
+    free(s->added);
+    free(s->env);
+    for (size_t i = 0; i < s->nenvmaps; i++)
+        murk_envmap_free(s->envmaps[i]);
+    free(s->envmaps);
     murk_registry_free(&s->reg);
     murk_ydoc_free(&s->doc);
     free(s);

@@ -10,7 +10,7 @@
 
 #include <stddef.h>
 #include "murk/plugin.h"
-#include "yamldoc.h"
+#include "yaml/yamldoc.h"
 
 /* Parses a texture map node; values must lie in [lo, hi] (the parameter's range; PNG texels are in
  * [0,1] and must fit it too). scene_path resolves relative file names. NULL with a located error. */

@@ -1,8 +1,8 @@
 /* texture.c — constant, checkerboard and PNG image textures (see texture.h for the scene syntax). */
-#include "texture.h"
-#include "image.h"
-#include "util.h"
-#include "yread.h"
+#include "scene/texture.h"
+#include "image/image.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
 #include <stdio.h>

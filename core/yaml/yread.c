@@ -1,8 +1,8 @@
 /* yread.c — typed, range-checked readers of YAML nodes with located errors, shared by the scene,
  * media and texture loaders. */
-#include "yread.h"
-#include "limit.h"
-#include "util.h"
+#include "yaml/yread.h"
+#include "util/limit.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <math.h>

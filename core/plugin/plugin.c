@@ -3,8 +3,9 @@
  * before it is checked; then the entry function's descriptor is checked field by field. Every refusal
  * is one line naming the file and the cause. */
 #define _GNU_SOURCE /* dladdr() */
-#include "plugin_loader.h"
-#include "util.h"
+#include "plugin/plugin_loader.h"
+#include "util/runtime.h"
+#include "util/util.h"
 
 #include "murk/integrator.h"
 #include "murk/material.h"

@@ -4,17 +4,18 @@
  * Every key is checked: the core's own blocks against the tables below, plugin blocks against the
  * plugin's parameter schema (params.c); the `media:` block is media.c's. Every error is one line
  * "file:line:col: what is wrong". */
-#include "scene.h"
-#include "accel.h"
-#include "checkpoint.h"
-#include "host.h"
-#include "limit.h"
-#include "media.h"
+#include "load/load.h"
+#include "media/media.h"
 #include "media/source.h"
-#include "obj.h"
-#include "params.h"
-#include "util.h"
-#include "yread.h"
+#include "render/accel.h"
+#include "render/checkpoint.h"
+#include "render/host.h"
+#include "render/lights.h"
+#include "scene/obj.h"
+#include "scene/params.h"
+#include "util/limit.h"
+#include "util/util.h"
+#include "yaml/yread.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -174,7 +175,7 @@ static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t err
     return 0;
 }
 
-static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+static int load_materials(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     if (!n)
         return 0;
@@ -197,8 +198,8 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
         void *self;
         char who_type[512];
         snprintf(who_type, sizeof who_type, "%s (%s)", who, type);
-        if (murk_scene_instantiate(s, MURK_KIND_MATERIAL, t, type, m, who, who_type, skip, 1, NULL, &p, &self, err,
-                                   errlen))
+        if (murk_scene_instantiate(s, host, MURK_KIND_MATERIAL, t, type, m, who, who_type, skip, 1, NULL, &p, &self,
+                                   err, errlen))
             return -1;
         nm->name = murk_strdup(n->keys[i]);
         nm->m.vt = p->desc->vtable;
@@ -210,7 +211,7 @@ static int load_materials(murk_scene *s, const murk_ynode *n, char *err, size_t 
     return 0;
 }
 
-static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+static int load_integrator(murk_scene *s, const murk_host *host, const murk_ynode *n, char *err, size_t errlen)
 {
     static const char *const skip[] = {"type"};
     static const murk_ynode empty = {.kind = MURK_Y_MAP, .file = "(default)", .line = 1, .col = 1};
@@ -228,8 +229,8 @@ static int load_integrator(murk_scene *s, const murk_ynode *n, char *err, size_t
     const murk_ynode *t = murk_ymap_get(n, "type");
     char who[256];
     snprintf(who, sizeof who, "integrator '%s'", type);
-    if (murk_scene_instantiate(s, MURK_KIND_INTEGRATOR, t ? t : n, type, n, "integrator", who, skip, 1, NULL, &p,
-                               &s->integrator, err, errlen))
+    if (murk_scene_instantiate(s, host, MURK_KIND_INTEGRATOR, t ? t : n, type, n, "integrator", who, skip, 1, NULL,
+                               &p, &s->integrator, err, errlen))
         return -1;
     const murk_integrator_vt *vt = p->desc->vtable;
     s->integrator_plugin = p;
@@ -541,7 +542,7 @@ static int check_unused(const murk_ynode *root, int only_set, char *err, size_t 
 static int load_document(murk_scene *s, char *err, size_t errlen)
 {
     static const char *const keys[] = {"murk", "render", "camera", "integrator", "background",
-                                       "materials", "media", "shapes"};
+                                       "materials", "media", "shapes", "lights"};
     const murk_ynode *root = s->doc.root;
     if (!root)
         return murk_yerr(err, errlen, &(murk_ynode){.file = s->doc.file, .line = 1, .col = 1},
@@ -556,6 +557,8 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return ERR(v, "scene format version %lld is not supported (this murk reads version 1)", ver);
     if (check_unused(root, 1, err, errlen))
         return -1;
+    /* the services table every plugin's create() receives, handed down to the blocks that create them */
+    const murk_host *host = murk_host_table();
     const murk_ynode *c;
     if (load_render(s, murk_ymap_get(root, "render"), err, errlen))
         return -1;
@@ -564,16 +567,19 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     s->background = to_rgb(bg);
     if ((c = murk_ymap_get(root, "media"))) {
-        if (murk_media_load(s, c, err, errlen))
+        if (murk_media_load(s, host, c, err, errlen))
             return -1;
     }
     if (load_camera(s, murk_ymap_get(root, "camera"), err, errlen))
         return -1;
-    if (load_materials(s, murk_ymap_get(root, "materials"), err, errlen))
+    if (load_materials(s, host, murk_ymap_get(root, "materials"), err, errlen))
         return -1;
-    if (load_integrator(s, murk_ymap_get(root, "integrator"), err, errlen))
+    if (load_integrator(s, host, murk_ymap_get(root, "integrator"), err, errlen))
         return -1;
-    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen))
+    /* an integrator built before the lights' ABI gets only emissive shapes to sample (render/lights.h) */
+    s->legacy_lights = s->integrator_plugin->abi.minor < MURK_ABI_MINOR_LIGHTS;
+    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen) ||
+        murk_load_lights(s, murk_ymap_get(root, "lights"), err, errlen))
         return -1;
     murk_vec3 lo, hi;
     scene_bounds(s, &lo, &hi);
@@ -624,6 +630,10 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
             return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;
+    const murk_ynode *lights = murk_ymap_get(root, "lights");
+    for (size_t i = 0; lights && lights->kind == MURK_Y_SEQ && i < lights->n; i++) /* environment maps */
+        if (names(lights->items[i], "type", "envmap") && hash_input(s, murk_ymap_get(lights->items[i], "file"), &h, err, errlen))
+            return 0;
     return h ? h : 1;
 }
 
@@ -645,10 +655,10 @@ MURK_API murk_scene *murk_scene_load(const char *path, const char *const *sets, 
             murk_scene_free(s);
             return NULL;
         }
-    if (load_document(s, err, errlen) != 0 || murk_accel_build(s, err, errlen) != 0) {
+    if (load_document(s, err, errlen) != 0 || murk_accel_build(s, err, errlen) != 0 ||
+        murk_lights_build(s, err, errlen) != 0) {
         murk_scene_free(s);
         return NULL;
     }
-    murk_lights_build(s);
     return s;
 }

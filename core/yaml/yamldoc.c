@@ -1,8 +1,8 @@
 /* yamldoc.c — libyaml events to a located tree; --set overrides. */
-#include "yamldoc.h"
-#include "file.h"
-#include "error.h"
-#include "util.h"
+#include "yaml/yamldoc.h"
+#include "util/error.h"
+#include "util/file.h"
+#include "util/util.h"
 
 #include <errno.h>
 #include <stdarg.h>

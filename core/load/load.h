@@ -1,0 +1,43 @@
+/* load.h — the scene loader's functions beyond the public murk_scene_load / murk_scene_free (murk.h):
+ * the command's rules and the content hash (load.c), a shape's release (free.c). Internal to libmurk. */
+#ifndef MURK_LOAD_H
+#define MURK_LOAD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "scene/scene.h"
+
+/* The murk command's rule for a loaded scene: a medium or material that no shape (and, for a medium,
+ * not the camera) references is an error, "FILE:LINE:COL: media.NAME is not used by any shape or by the
+ * camera; did you mean media.OTHER?" (or "--set ...: ..." for one a --set made). murk_scene_load itself
+ * refuses only those a --set made (a misspelt name): embedders may load media and materials to call
+ * them directly. Returns 0, or -1 with err. */
+int murk_scene_check_unused(const murk_scene *s, char *err, size_t errlen);
+
+/* The content hash a checkpoint carries: the scene file and every file it loads (meshes, density
+ * grids, image textures, as named after the --set overrides), each with its path; so a resume after
+ * any of them changed is refused. 0 with err if one cannot be read. */
+uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
+
+/* The `lights:` list (light_block.c): each light checked and added (render/lights.h). 0, or -1 with a
+ * located err. */
+int murk_load_lights(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+
+/* Releases what a shape owns (its triangle arrays). */
+void murk_shape_free(murk_shape *sh);
+
+/* What a loaded scene holds in memory, item by item (memory.c): each medium's density field with its bound
+ * grid, each mesh (positions, uvs, normals, indices, triangle normals), each texture (texels as floats), and
+ * Embree's scene (its BVH and its copies of the buffers, as its memory monitor counts them). Bytes as
+ * allocated, without the allocator's own overhead. */
+typedef struct murk_mem_item {
+    const char *kind;   /* "grid", "mesh", "texture", "embree" */
+    char name[160];     /* the medium, the file, or "scene" */
+    char detail[160];   /* e.g. "sparse, 32221669 active voxels in 68051 bricks" */
+    uint64_t bytes;
+} murk_mem_item;
+/* Fills items[0..cap) and returns how many there are (it may exceed cap: call again with more room). */
+size_t murk_scene_memory(const murk_scene *s, murk_mem_item *items, size_t cap);
+
+#endif

@@ -1,0 +1,80 @@
+/* runtime.c — the run-time state libmurk's layers share (runtime.h): the log and its quiet switch, the
+ * once-only warnings, and every thread's cost counters. */
+#include "util/runtime.h"
+#include "util/util.h"
+
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int quiet;
+
+MURK_API void murk_set_quiet(int q) { quiet = q; }
+
+MURK_API void murk_log(int level, const char *fmt, ...)
+{
+    if (quiet && level == MURK_LOG_INFO)
+        return;
+    char raw[2048], safe[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(raw, sizeof raw, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "%s%s\n", level == MURK_LOG_WARN ? "murk: warning: " : "murk: ", murk_printable(safe, sizeof safe, raw));
+}
+
+static pthread_mutex_t warn_lock = PTHREAD_MUTEX_INITIALIZER;
+static struct { char *msg; unsigned long count; } warned[128];
+static int nwarned;
+
+void murk_warn_once(const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    pthread_mutex_lock(&warn_lock);
+    int i = 0;
+    while (i < nwarned && strcmp(warned[i].msg, buf) != 0)
+        i++;
+    if (i < nwarned) {
+        warned[i].count++;
+    } else if (nwarned < (int)(sizeof warned / sizeof warned[0])) {
+        warned[nwarned].msg = murk_strdup(buf);
+        warned[nwarned].count = 1;
+        nwarned++;
+        murk_log(MURK_LOG_WARN, "%s", buf);
+    }
+    pthread_mutex_unlock(&warn_lock);
+}
+
+MURK_API void murk_warn_summary(void)
+{
+    pthread_mutex_lock(&warn_lock);
+    for (int i = 0; i < nwarned; i++) {
+        if (warned[i].count > 1)
+            murk_log(MURK_LOG_WARN, "(%lu times in all) %s", warned[i].count, warned[i].msg);
+        free(warned[i].msg);
+    }
+    nwarned = 0;
+    pthread_mutex_unlock(&warn_lock);
+}
+
+_Thread_local murk_counters murk_thread_counters[MURK_COUNTER_SLOTS];
+
+void murk_thread_counters_reset(void) { memset(murk_thread_counters, 0, sizeof murk_thread_counters); }
+
+void murk_thread_counters_add(murk_counters *sum, size_t n)
+{
+    for (size_t i = 0; i < n && i < MURK_COUNTER_SLOTS; i++) {
+        const murk_counters *c = &murk_thread_counters[i];
+        sum[i].lookups += c->lookups;
+        sum[i].cells += c->cells;
+        sum[i].collisions += c->collisions;
+        sum[i].scatters += c->scatters;
+        sum[i].shadow += c->shadow;
+    }
+}
