@@ -1,4 +1,4 @@
-/* bsdftest.c — see bsdftest.h. The sphere quadrature and the chi-square test are core/check/sphere.c,
+/* bsdftest.c — see bsdftest.h. The sphere quadrature and the chi-square test are core/lab/check/sphere.c,
  * the same code `murk check` runs on any material. */
 #include "bsdftest.h"
 
@@ -171,7 +171,7 @@ murk_vec3 bt_dir(double theta, double phi)
     return murk_v3((float)(sin(theta) * cos(phi)), (float)(sin(theta) * sin(phi)), (float)cos(theta));
 }
 
-/* ---- Sphere cells and quadrature: core/check/sphere.c (shared with `murk check`) ---------------------- */
+/* ---- Sphere cells and quadrature: core/lab/check/sphere.c (shared with `murk check`) ---------------------- */
 double bt_integrate_cell(bt_fn fn, void *ctx, const bt_grid *g, int it, int ip, double tol, double *err)
 {
     return murk_sph_integrate_cell(fn, ctx, g, it, ip, tol, err);

@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "murk/material.h"
-#include "check/sphere.h"
+#include "lab/check/sphere.h"
 #include "testutil.h"
 
 /* ---- Instances ------------------------------------------------------------------------------- */
@@ -65,7 +65,7 @@ murk_vec3 bt_dir(double theta, double phi);
  * tolerance max(tol, 1e-6 |integral|) (tol in units of the integrand times steradians), within a fixed
  * budget of subintervals; the error estimates (|K15 - G7| summed, inner errors propagated) are
  * reported, also where the budget stopped the refinement. */
-typedef murk_sph_grid bt_grid; /* ntheta, nphi, pole, warp: see core/check/sphere.h */
+typedef murk_sph_grid bt_grid; /* ntheta, nphi, pole, warp: see core/lab/check/sphere.h */
 
 typedef murk_sph_fn bt_fn;
 

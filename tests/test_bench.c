@@ -4,7 +4,7 @@
  * and maps, and a bench interrupted by SIGINT/SIGTERM (whole rows only, nothing half-written). */
 #include "testutil.h"
 
-#include "cli/metrics.h"
+#include "murk/lab.h"
 #include "murk/murk.h"
 
 #include <dirent.h>

@@ -2,12 +2,16 @@
  * --help` print usage on stdout and exit 0 for every subcommand; unknown options and commands exit 2 with
  * the usage on stderr and nothing on stdout; `murk info` lists what a scene holds (camera, render
  * settings, media with tracker, estimator, grid and majorant, materials, shapes, plugins with paths),
- * with --set applied and checked as `murk render` checks it. */
+ * with --set applied and checked as `murk render` checks it. Every file `murk render` will write is
+ * checked before the first sample. */
 #include "testutil.h"
 
+#include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static const char *const commands[] = {"render", "info", "plugins", "compare", "check", "grid", "help"};
@@ -182,6 +186,93 @@ static void test_affinity(void **state)
     free(log);
 }
 
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The names in dir, sorted, space-separated. */
+static void dir_names(const char *dir, char *buf, size_t n)
+{
+    struct dirent **e;
+    int k = scandir(dir, &e, NULL, alphasort);
+    assert_true(k >= 0);
+    buf[0] = 0;
+    for (int i = 0; i < k; i++) {
+        if (e[i]->d_name[0] != '.')
+            snprintf(buf + strlen(buf), n - strlen(buf), "%s%s", buf[0] ? " " : "", e[i]->d_name);
+        free(e[i]);
+    }
+    free(e);
+}
+
+/* Renders the small Cornell box with `spp` samples and the extra arguments (NULL-terminated): the exit
+ * status, the output in *out and the seconds it took in *secs. */
+static int render_cornell(const char *exr, const char *spp, const char *const *extra, char **out, double *secs)
+{
+    const char *args[32] = {"render", src_path("scenes/cornell.yaml"), "-o", exr, "--spp", spp, "--threads", "2",
+                            "--quiet", "--set", "render.resolution=[48,40]"};
+    int n = 11;
+    for (int i = 0; extra && extra[i]; i++)
+        args[n++] = extra[i];
+    args[n] = NULL;
+    double t0 = now();
+    int rc = run_murk_argv(out, args);
+    *secs = now() - t0;
+    return rc;
+}
+
+/* An output that cannot be written — the image in a folder that does not exist or is a file, its PNG
+ * preview a directory, MURK_SAMPLE_DUMP's file in a missing folder, a folder without write permission —
+ * is a one-line error, exit 1, in less than a second on a render that takes several: murk found it only
+ * when writing, after the whole render. Nothing is written. */
+static void test_outputs_checked_first(void **state)
+{
+    (void)state;
+    char *out = NULL, names[1024], spp[32], dir[4096];
+    double secs;
+    snprintf(dir, sizeof dir, "%s", tmp_path("outputs")); /* tmp_path's buffers rotate */
+    mkdir(dir, 0777);
+    double t[2];
+    for (int k = 0; k < 2; k++) { /* a render of about 5 s: seconds per spp from 4 and 36 spp */
+        assert_int_equal(render_cornell(tmp_path("outputs/probe.exr"), k ? "36" : "4", NULL, &out, &t[k]), 0);
+        free(out);
+    }
+    snprintf(spp, sizeof spp, "%d", (int)(5.0 / ((t[1] - t[0]) / 32 > 1e-4 ? (t[1] - t[0]) / 32 : 1e-4)));
+    assert_int_equal(mkdir(tmp_path("outputs/o.png"), 0777), 0);
+    fclose(fopen(tmp_path("outputs/file"), "w"));
+    remove(tmp_path("outputs/probe.exr"));
+    remove(tmp_path("outputs/probe.png"));
+    struct {
+        const char *exr, *dump, *says;
+    } cases[] = {
+        {"outputs/missing/o.exr", NULL, "missing/o.exr: cannot write the image: No such file or directory"},
+        {"outputs/file/o.exr", NULL, "file/o.exr: cannot write the image: Not a directory"},
+        {"outputs/o.exr", NULL, "o.png: is a directory; murk only replaces regular files"},
+        {"outputs/d.exr", "outputs/missing/d.bin", "cannot write the sample dump (MURK_SAMPLE_DUMP): No such file"},
+        {"outputs/ro/o.exr", NULL, "ro/o.exr: cannot write the image: Permission denied"},
+    };
+    mkdir(tmp_path("outputs/ro"), 0555); /* root may write there anyway: that case only when not root */
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0] - (geteuid() == 0); i++) {
+        if (cases[i].dump)
+            setenv("MURK_SAMPLE_DUMP", tmp_path(cases[i].dump), 1);
+        int rc = render_cornell(tmp_path(cases[i].exr), spp, NULL, &out, &secs);
+        unsetenv("MURK_SAMPLE_DUMP");
+        if (secs >= 1.0)
+            fail_msg("%s: refused after %.2f s, not before rendering:\n%s", cases[i].exr, secs, out);
+        assert_int_equal(rc, 1);
+        assert_contains(out, cases[i].says);
+        assert_ptr_equal(strchr(out, '\n'), out + strlen(out) - 1);
+        free(out);
+    }
+    dir_names(dir, names, sizeof names);
+    assert_string_equal(names, "file o.png ro");
+    dir_names(tmp_path("outputs/o.png"), names, sizeof names);
+    assert_string_equal(names, "");
+}
+
 int main(void)
 {
     unsetenv("MURK_PLUGIN_PATH");
@@ -190,6 +281,7 @@ int main(void)
         cmocka_unit_test(test_unknown_options),
         cmocka_unit_test(test_info),
         cmocka_unit_test(test_affinity),
+        cmocka_unit_test(test_outputs_checked_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

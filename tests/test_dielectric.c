@@ -302,7 +302,7 @@ static void test_energy(void **state)
     assert_int_equal(bad, 0);
 }
 
-/* `murk check` on transmitting materials (core/check/check.c): it must pass the dielectric and a correct
+/* `murk check` on transmitting materials (core/lab/check/check.c): it must pass the dielectric and a correct
  * frosted fixture, and fail each of two broken ones exactly where they are broken — a sampler wrong only
  * from inside (the chi-square from inside; the outside one still passes) and transmission that is not
  * reciprocal across the interface (the f(a,b)/eta_a^2 = f(b,a)/eta_b^2 line: the constant is eta^2 = 2.25

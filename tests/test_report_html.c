@@ -1,4 +1,4 @@
-/* test_report_html.c — the comparison page's C side (core/cli/report_html.c): the half-float encoding
+/* test_report_html.c — the comparison page's C side (core/lab/report_html.c): the half-float encoding
  * (every half round-trips, random floats go to the nearest half with ties to even, NaN/Inf/denormals keep
  * what they are), the per-array power-of-two scale, the size limit and its downsampling, the written
  * page; and `murk compare --html` on bad input: images of different sizes, an unwritable or odd --html
@@ -7,7 +7,7 @@
 #include "testutil.h"
 
 #include "image/image.h"
-#include "cli/report_html.h"
+#include "lab/report_html.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -4,7 +4,8 @@
  * identical to an uninterrupted render of the same spp. An interrupted render must exit with 128 + the
  * signal, write the image of the spp it reached (murk:spp, murk:interrupted) or nothing, and leave no
  * temporary file behind. A checkpoint of another scene / other overrides is refused. A SIGHUP that was
- * ignored when murk started (nohup) stays ignored. */
+ * ignored when murk started (nohup) stays ignored. A --checkpoint that cannot be written is refused
+ * before the first sample. */
 #include "image/image.h"
 #include "testutil.h"
 
@@ -394,11 +395,50 @@ static void test_resume_refuses_changed_inputs(void **state)
     }
 }
 
+/* A --checkpoint in a folder that does not exist, or is a file, or (when not root) has no write
+ * permission: one line, exit 1, in less than a second on a render of several seconds, and no image —
+ * murk found it only after the whole render, which it wrote, unprotected all along. */
+static void test_unwritable_checkpoint(void **state)
+{
+    (void)state;
+    render_reference();
+    const char *dir = make_dir("unwritable");
+    char spp[32], file[4096], ro[4096];
+    snprintf(spp, sizeof spp, "%d", (int)(atoi(SPP) * 5.0 / t_ref) + 1); /* at least 5 s of rendering */
+    snprintf(file, sizeof file, "%s/file", dir);
+    fclose(fopen(file, "w"));
+    snprintf(ro, sizeof ro, "%s/ro", dir);
+    mkdir(ro, 0555);
+    static const char *const cks[][2] = {{"missing/ck", "No such file or directory"},
+                                         {"file/ck", "Not a directory"},
+                                         {"ro/ck", "Permission denied"}};
+    for (size_t i = 0; i < 3 - (geteuid() == 0); i++) { /* root may write into ro/ */
+        char ck[4096], exr[4096], want[4200], *out = NULL;
+        snprintf(ck, sizeof ck, "%s/%s", dir, cks[i][0]);
+        snprintf(exr, sizeof exr, "%s/o.exr", dir);
+        double t0 = now();
+        int rc = run_murk(&out, "render", scene_path(), "-o", exr, "--spp", spp, "--threads", "2", "--quiet",
+                          "--set", "render.resolution=[48,40]", "--checkpoint", ck, NULL);
+        double secs = now() - t0;
+        if (secs >= 1.0)
+            fail_msg("--checkpoint %s: refused after %.2f s (a render of %s spp), not before it:\n%s", cks[i][0],
+                     secs, spp, out);
+        assert_int_equal(rc, 1);
+        snprintf(want, sizeof want, "murk: %s: cannot write the checkpoint: %s\n", ck, cks[i][1]);
+        assert_string_equal(out, want);
+        free(out);
+        assert_false(exists(dir, "o.exr"));
+        assert_false(exists(dir, "o.png"));
+        no_temporaries(dir);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resume_refuses),
         cmocka_unit_test(test_resume_refuses_changed_inputs),
+        cmocka_unit_test(test_unwritable_checkpoint),
         cmocka_unit_test(test_interrupted_image),
         cmocka_unit_test(test_nohup_keeps_rendering),
         cmocka_unit_test(test_kill_resume_bitwise),

@@ -1,13 +1,16 @@
 #!/bin/sh
 # test_sdk.sh — the plugin author's path of docs/plugins.md, end to end, against an INSTALLED murk:
 #   1. `meson install --destdir` this build into a fresh temporary folder;
-#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0) and, with no
+#   2. the installed murk runs with no LD_LIBRARY_PATH (its install RPATH finds libmurk.so.0 and
+#      libmurklab.so.0, the lab, whose code libmurk does not hold) and, with no
 #      MURK_PLUGIN_PATH, finds and renders with its built-in plugins (the murk/plugins folder beside
 #      the installed libmurk, though the install is staged away from its prefix);
 #   3. copy the installed share/murk/examples, build them out of tree with their own meson.build and
 #      the installed murk-plugin.pc (PKG_CONFIG_PATH into the temporary prefix);
 #   4. the installed murk lists them (MURK_PLUGIN_PATH), `murk check`s each one, and renders a scene
-#      that names all three (material, tracker, integrator).
+#      that names all three (material, tracker, integrator);
+#   5. the installed murk benches that scene (charts from the installed chart script), and a program
+#      built against the installed murk-lab.pc reads a plugin's schema through murk/lab.h.
 # Usage: test_sdk.sh MESON   (the meson executable); MURK_BUILD_ROOT is the build folder (meson test
 # sets it). Writes nothing outside one temporary folder, which it removes.
 set -eu
@@ -35,6 +38,15 @@ BUILTINS=$(dirname "$BUILTINS")
 step "the installed murk finds libmurk through its RPATH"
 readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
 env -u LD_LIBRARY_PATH "$MURK" --version || fail "installed murk does not start (RPATH?)"
+
+step "the lab is libmurklab, apart from libmurk"
+LIBMURK=$(find "$TMP/root" -name libmurk.so.0 | head -n 1)
+LIBLAB=$(find "$TMP/root" -name libmurklab.so.0 | head -n 1)
+[ -n "$LIBMURK" ] && [ -n "$LIBLAB" ] || fail "libmurk.so.0 or libmurklab.so.0 not installed"
+[ -n "$(find "$TMP/root" -path '*/include/murk/lab.h')" ] || fail "murk/lab.h not installed"
+nm -D --defined-only "$LIBLAB" | grep -q ' murk_lab_check$' || fail "libmurklab does not export murk_lab_check"
+nm -D --defined-only "$LIBMURK" | grep -E ' murk_(lab|check|chi2|sph)_' && fail "libmurk holds the lab's code"
+readelf -d "$MURK" | grep -q 'libmurklab' || fail "the installed murk does not link libmurklab"
 
 step "the installed murk finds its built-in plugins beside its libmurk (no MURK_PLUGIN_PATH)"
 # the install is staged under a destdir, not at its configured prefix: only a search relative to the
@@ -110,4 +122,34 @@ EOF
 "$MURK" render "$TMP/examples.yaml" -o "$TMP/examples_vol.exr" --threads 2 --set integrator.type=volpath_nee ||
   fail "murk render with volpath_nee and example_delta"
 "$MURK" compare "$TMP/examples_vol.exr" "$TMP/examples.exr" || fail "the rendered EXRs do not read back"
+step "murk bench with the installed murk (its chart script found beside the installed libmurklab)"
+MURK_CACHE_DIR="$TMP/cache" "$MURK" bench "$TMP/examples.yaml" --spp 1,2 --repeat 2 --ref-spp 4 \
+  --set 'render.resolution=[8,6]' -o "$TMP/bench" >"$TMP/bench.log" 2>&1 || { cat "$TMP/bench.log"; fail "murk bench"; }
+for f in bench.csv bench.json report.md report.html maps/variant0.npy; do
+  [ -s "$TMP/bench/$f" ] || { cat "$TMP/bench.log"; fail "murk bench wrote no $f"; }
+done
+
+step "a program on the installed murk-lab.pc: a plugin's schema through murk/lab.h"
+cat >"$TMP/schema.c" <<'EOF'
+#include <stdio.h>
+#include "murk/lab.h"
+int main(void)
+{
+    char err[1024];
+    murk_lab_plugin_info info;
+    murk_lab_plugin *p = murk_lab_plugin_open("example_matte", &info, err, sizeof err);
+    if (!p) {
+        fprintf(stderr, "%s\n", err);
+        return 1;
+    }
+    printf("%s: %u parameters, the first %s\n", info.name, info.nparams, info.nparams ? info.params[0].name : "-");
+    murk_lab_plugin_close(p);
+    return 0;
+}
+EOF
+# shellcheck disable=SC2046 # pkg-config's flags are words
+cc -std=c11 -Wall -Wextra -Werror $(pkg-config --cflags murk-lab) -o "$TMP/schema" "$TMP/schema.c" \
+  $(pkg-config --libs murk-lab) || fail "building against murk-lab.pc"
+LD_LIBRARY_PATH=$(dirname "$LIBLAB") "$TMP/schema" || fail "the program on libmurklab"
+
 echo "sdk: all steps passed"

@@ -1,7 +1,7 @@
 /* testutil.c — see testutil.h */
 #include "testutil.h"
 #include "image/image.h"
-#include "check/sphere.h"
+#include "lab/check/sphere.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -142,7 +142,7 @@ int run_murk_argv(char **out, const char *const *args) { return run_captured(out
 
 int run_murk_split(char **out, char **err, const char *const *args) { return run_captured(out, err, args); }
 
-/* The same chi-square test as `murk check` (core/check/sphere.c). */
+/* The same chi-square test as `murk check` (core/lab/check/sphere.c). */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out)
 {
     return murk_chi2_test(observed, expected, nbins, min_expected, dof_out);

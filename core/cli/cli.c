@@ -7,7 +7,6 @@
  *   murk help [COMMAND], murk COMMAND --help: usage on stdout, exit 0
  * This file is part of the murk executable, not of libmurk: it calls libmurk's MURK_API functions.
  * Exit status: 0 success, 1 bad input or failure (one line on stderr), 2 usage error. */
-#include "check/check.h"
 #include "cli/cli.h"
 #include "image/image.h"
 #include "load/load.h"
@@ -21,6 +20,7 @@
 #include "util/limit.h"
 #include "util/runtime.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <errno.h>
 #include <math.h>
@@ -107,7 +107,7 @@ static int command_usage(const char *cmd)
     for (size_t i = 0; i < sizeof command_help / sizeof command_help[0]; i++)
         if (!strcmp(command_help[i].name, cmd)) {
             if (!command_help[i].text)
-                return murk_cli_bench(1, (char *[]){"--help", NULL});
+                return murk_lab_bench(1, (char *[]){"--help", NULL});
             fputs(command_help[i].text, stdout);
             return 0;
         }
@@ -311,218 +311,242 @@ static int parse_part(const char *v, int *part, int *parts)
     return 0;
 }
 
-static int render_main(int argc, char **argv)
+/* What `murk render` was asked: the command line, the output files' names, and the texts that identify
+ * the render (its --set overrides; with its part, a checkpoint's identity). */
+typedef struct render_args {
+    const char *scene, *out;
+    const char **sets;
+    size_t nsets;
+    murk_render_opts opts;
+    int quiet, every_given;
+    char *exr, *png;
+    char setbuf[4096], ckid[4200], parttag[64];
+} render_args;
+
+/* A number of seconds for opt: > 0 (positive = 1) or >= 0. 0, or 2 after the message. */
+static int parse_seconds(const char *opt, const char *v, int positive, double *out)
 {
-    volatile sig_atomic_t *stop = murk_cli_catch_stop_signals();
-    const char *scene_path = NULL, *out = NULL;
-    const char **sets = murk_xmalloc((size_t)argc * sizeof *sets);
-    size_t nsets = 0;
-    murk_render_opts opts = {0};
-    opts.checkpoint_every = 60;
-    int quiet = 0, every_given = 0;
-    for (int i = 0; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        long x;
-        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!v)
-                return free(sets), usage("-o needs a file name");
-            out = v, i++;
-        } else if (!strcmp(a, "--spp")) {
-            if (parse_int_arg(a, v, 1, 1 << 24, &x))
-                return free(sets), 2;
-            opts.spp = (int)x, i++;
-        } else if (!strcmp(a, "--threads")) {
-            if (parse_int_arg(a, v, 1, 1024, &x))
-                return free(sets), 2;
-            opts.threads = (int)x, i++;
-        } else if (!strcmp(a, "--time")) {
-            char *end;
-            double t = v ? strtod(v, &end) : 0;
-            if (!v || *end || !(t > 0) || !isfinite(t)) {
-                fprintf(stderr, "murk: --time needs a positive number of seconds, got '%s'\n", v ? v : "");
-                return free(sets), 2;
-            }
-            opts.time_limit = t, i++;
-        } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume")) {
-            if (!v || !*v)
-                return free(sets), usage(a[2] == 'c' ? "--checkpoint needs a file name" : "--resume needs a file name");
-            *(a[2] == 'c' ? &opts.checkpoint : &opts.resume) = v, i++;
-        } else if (!strcmp(a, "--every")) {
-            char *end;
-            double t = v ? strtod(v, &end) : -1;
-            if (!v || *end || !(t >= 0) || !isfinite(t)) {
-                fprintf(stderr, "murk: --every needs a number of seconds >= 0, got '%s'\n", v ? v : "");
-                return free(sets), 2;
-            }
-            opts.checkpoint_every = t, every_given = 1, i++;
-        } else if (!strcmp(a, "--part")) {
-            if (parse_part(v, &opts.part, &opts.parts))
-                return free(sets), 2;
-            i++;
-        } else if (!strcmp(a, "--set")) {
-            if (!v)
-                return free(sets), usage("--set needs KEY.PATH=VALUE");
-            sets[nsets++] = v, i++;
-        } else if (!strncmp(a, "--set=", 6)) {
-            sets[nsets++] = a + 6;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            quiet = 1;
-        } else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "murk: unknown option '%s'\n", q(a));
-            return free(sets), usage(NULL);
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n", q(scene_path), q(a));
-            return free(sets), 2;
-        }
-    }
-    if (!scene_path)
-        return free(sets), usage("render needs a scene file");
-    if (every_given && !opts.checkpoint)
-        return free(sets), usage("--every needs --checkpoint");
-    if (opts.parts && opts.time_limit > 0)
-        return free(sets), usage("--part cannot be combined with --time: the parts of an image must have the same spp");
-    struct stat sst;
-    if (stat(scene_path, &sst) == 0 && !S_ISREG(sst.st_mode)) { /* before deriving an output name from it */
-        fprintf(stderr, "%s: is %s, not a scene file\n", q(scene_path), /* as the loader would say it */
-                S_ISDIR(sst.st_mode) ? "a directory" : S_ISFIFO(sst.st_mode) ? "a FIFO" :
-                S_ISCHR(sst.st_mode) || S_ISBLK(sst.st_mode) ? "a device" : "not a regular file");
-        return free(sets), 1;
-    }
-    char *outbuf = out ? murk_strdup(out) : default_output(scene_path);
-    size_t ol = strlen(outbuf);
-    if (ol < 5 || strcmp(outbuf + ol - 4, ".exr") != 0) {
-        fprintf(stderr, "murk: the output file must end in .exr, got '%s'\n", q(outbuf));
-        free(outbuf);
-        free(sets);
+    char *end;
+    double t = v ? strtod(v, &end) : -1;
+    if (!v || *end || !(positive ? t > 0 : t >= 0) || !isfinite(t)) {
+        fprintf(stderr, "murk: %s needs %s, got '%s'\n", opt,
+                positive ? "a positive number of seconds" : "a number of seconds >= 0", v ? v : "");
         return 2;
     }
-    if (mpi_run.rank == 0) { /* refuse before rendering: an output path naming a directory, device, FIFO or link */
-        char oerr[1024], *png0 = png_path_for(outbuf);
-        int bad = murk_output_check(outbuf, oerr, sizeof oerr) || murk_output_check(png0, oerr, sizeof oerr);
-        free(png0);
-        if (bad) {
-            cli_error(oerr);
-            free(outbuf);
-            free(sets);
-            return 1;
+    *out = t;
+    return 0;
+}
+
+/* The argument argv[*i] of `murk render` (and its value, argv[*i + 1], which *i then skips). 0, or the
+ * exit status of a usage error after its message. */
+static int render_option(render_args *ra, int argc, char **argv, int *i)
+{
+    const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
+    murk_render_opts *o = &ra->opts;
+    long x;
+    int takes = 1; /* the option takes v */
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        if (!v)
+            return usage("-o needs a file name");
+        ra->out = v;
+    } else if (!strcmp(a, "--spp") || !strcmp(a, "--threads")) {
+        if (parse_int_arg(a, v, 1, a[2] == 's' ? 1 << 24 : 1024, &x))
+            return 2;
+        *(a[2] == 's' ? &o->spp : &o->threads) = (int)x;
+    } else if (!strcmp(a, "--time")) {
+        if (parse_seconds(a, v, 1, &o->time_limit))
+            return 2;
+    } else if (!strcmp(a, "--checkpoint") || !strcmp(a, "--resume")) {
+        if (!v || !*v)
+            return usage(a[2] == 'c' ? "--checkpoint needs a file name" : "--resume needs a file name");
+        *(a[2] == 'c' ? &o->checkpoint : &o->resume) = v;
+    } else if (!strcmp(a, "--every")) {
+        if (parse_seconds(a, v, 0, &o->checkpoint_every))
+            return 2;
+        ra->every_given = 1;
+    } else if (!strcmp(a, "--part")) {
+        if (parse_part(v, &o->part, &o->parts))
+            return 2;
+    } else if (!strcmp(a, "--set")) {
+        if (!v)
+            return usage("--set needs KEY.PATH=VALUE");
+        ra->sets[ra->nsets++] = v;
+    } else {
+        takes = 0;
+        if (!strncmp(a, "--set=", 6)) {
+            ra->sets[ra->nsets++] = a + 6;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            ra->quiet = 1;
+        } else if (a[0] == '-' && a[1]) {
+            fprintf(stderr, "murk: unknown option '%s'\n", q(a));
+            return usage(NULL);
+        } else if (!ra->scene) {
+            ra->scene = a;
+        } else {
+            fprintf(stderr, "murk: more than one scene given ('%s' and '%s')\n", q(ra->scene), q(a));
+            return 2;
         }
     }
-    murk_set_quiet(quiet);
-    char err[2048];
-    murk_scene *s = murk_cli_load(scene_path, sets, nsets);
-    if (!s) {
-        free(outbuf);
-        free(sets);
+    *i += takes;
+    return 0;
+}
+
+/* The command line of `murk render` into ra (ra->sets to be freed). 0, or the exit status. */
+static int parse_render_args(render_args *ra, int argc, char **argv)
+{
+    memset(ra, 0, sizeof *ra);
+    ra->sets = murk_xmalloc((size_t)(argc > 0 ? argc : 1) * sizeof *ra->sets);
+    ra->opts.checkpoint_every = 60;
+    for (int i = 0; i < argc; i++) {
+        int rc = render_option(ra, argc, argv, &i);
+        if (rc)
+            return rc;
+    }
+    if (!ra->scene)
+        return usage("render needs a scene file");
+    if (ra->every_given && !ra->opts.checkpoint)
+        return usage("--every needs --checkpoint");
+    if (ra->opts.parts && ra->opts.time_limit > 0)
+        return usage("--part cannot be combined with --time: the parts of an image must have the same spp");
+    return 0;
+}
+
+/* Before the scene is loaded: it is a file, the output's name ends in .exr, and (on rank 0, which writes
+ * them) the EXR and its PNG preview can be written; the session checks the files it writes itself. 0, or
+ * the exit status after the message. */
+static int check_outputs(render_args *ra)
+{
+    struct stat sst;
+    if (stat(ra->scene, &sst) == 0 && !S_ISREG(sst.st_mode)) { /* before deriving an output name from it */
+        fprintf(stderr, "%s: is %s, not a scene file\n", q(ra->scene), /* as the loader would say it */
+                S_ISDIR(sst.st_mode) ? "a directory" : S_ISFIFO(sst.st_mode) ? "a FIFO" :
+                S_ISCHR(sst.st_mode) || S_ISBLK(sst.st_mode) ? "a device" : "not a regular file");
         return 1;
     }
-    opts.progress = !quiet && murk_cli_progress();
-    char setbuf[4096] = "", ckid[4200], parttag[64] = "", fingerprint[4400];
-    for (size_t i = 0, k = 0; i < nsets && k < sizeof setbuf; i++)
-        k += (size_t)snprintf(setbuf + k, sizeof setbuf - k, "%s%s", i ? " " : "", sets[i]);
-    if (opts.parts)
-        snprintf(parttag, sizeof parttag, "%d/%d", opts.part, opts.parts);
-    if (opts.checkpoint || opts.resume || opts.parts || mpi_run.size > 1) {
-        opts.scene_hash = murk_scene_hash(s, err, sizeof err); /* the YAML and every file it loads */
+    ra->exr = ra->out ? murk_strdup(ra->out) : default_output(ra->scene);
+    size_t ol = strlen(ra->exr);
+    if (ol < 5 || strcmp(ra->exr + ol - 4, ".exr") != 0) {
+        fprintf(stderr, "murk: the output file must end in .exr, got '%s'\n", q(ra->exr));
+        return 2;
+    }
+    ra->png = png_path_for(ra->exr);
+    char oerr[1024]; /* a directory, device, FIFO or link, or a folder where nothing can be written */
+    if (mpi_run.rank == 0 && (murk_output_probe(ra->exr, "image", oerr, sizeof oerr) ||
+                              murk_output_probe(ra->png, "PNG preview", oerr, sizeof oerr))) {
+        cli_error(oerr);
+        return 1;
+    }
+    return 0;
+}
+
+/* The render's identity: its --set overrides, its part and, for a checkpoint, a part or MPI, the content
+ * hash of the scene and every file it loads; under MPI every rank agrees it was given what rank 0 was. 0,
+ * or 1 after the message. */
+static int identify(render_args *ra, const murk_scene *s)
+{
+    char err[2048], fingerprint[4400];
+    murk_render_opts *o = &ra->opts;
+    for (size_t i = 0, k = 0; i < ra->nsets && k < sizeof ra->setbuf; i++)
+        k += (size_t)snprintf(ra->setbuf + k, sizeof ra->setbuf - k, "%s%s", i ? " " : "", ra->sets[i]);
+    if (o->parts)
+        snprintf(ra->parttag, sizeof ra->parttag, "%d/%d", o->part, o->parts);
+    if (o->checkpoint || o->resume || o->parts || mpi_run.size > 1) {
+        o->scene_hash = murk_scene_hash(s, err, sizeof err); /* the YAML and every file it loads */
         /* a part's checkpoint is no other part's, nor the whole image's */
-        snprintf(ckid, sizeof ckid, "%s%s%s", setbuf, opts.parts ? " --part " : "", parttag);
-        opts.overrides = ckid;
-        if (!opts.scene_hash) {
+        snprintf(ra->ckid, sizeof ra->ckid, "%s%s%s", ra->setbuf, o->parts ? " --part " : "", ra->parttag);
+        o->overrides = ra->ckid;
+        if (!o->scene_hash) {
             fprintf(stderr, "%s\n", err);
-            murk_scene_free(s);
-            free(outbuf);
-            free(sets);
             return 1;
         }
     }
     snprintf(fingerprint, sizeof fingerprint, "scene %016llx, spp %d, seed %llu, %dx%d, part %s, time %g, --set %s",
-             (unsigned long long)opts.scene_hash, opts.spp > 0 ? opts.spp : s->spp, (unsigned long long)s->seed,
-             s->width, s->height, opts.parts ? parttag : "all", opts.time_limit, setbuf);
-    if (mpi_run.size > 1 && mpi_agree(1, fingerprint, NULL)) {
-        murk_scene_free(s);
-        free(outbuf);
-        free(sets);
-        return 1;
-    }
-    opts.stop = stop;
-    murk_render_result res;
-    if (murk_render_err(s, &opts, &res, err, sizeof err) != 0) {
-        if (err[0])
-            fprintf(stderr, "murk: %s\n", err);
-        if (!res.rgb) {
-            murk_scene_free(s);
-            free(outbuf);
-            free(sets);
-            return 1;
-        }
-    }
-    int ck_failed = err[0] != 0;
-    if (mpi_run.rank > 0) { /* rank 0 writes the image; this rank's status is rank 0's */
-        murk_warn_summary();
-        murk_scene_free(s);
-        free(outbuf);
-        free(sets);
-        return 0;
-    }
+             (unsigned long long)o->scene_hash, o->spp > 0 ? o->spp : s->spp, (unsigned long long)s->seed,
+             s->width, s->height, o->parts ? ra->parttag : "all", o->time_limit, ra->setbuf);
+    return mpi_run.size > 1 && mpi_agree(1, fingerprint, NULL);
+}
 
-    char spp[32], seed[32], secs[32], nonfinite[32], plugins[4096], interrupted[96] = "no", spp_asked[32];
-    char ranks[32], threads[32], tsecs[32], hash[32], exposure[32], ntiles[32], maxsample[40];
-    snprintf(maxsample, sizeof maxsample, "%.17g", res.max_sample);
-    murk_registry_describe(&s->reg, plugins, sizeof plugins);
-    snprintf(spp, sizeof spp, "%d", res.spp);
-    snprintf(spp_asked, sizeof spp_asked, "%d", opts.spp > 0 ? opts.spp : s->spp);
-    if (res.interrupted)
-        snprintf(interrupted, sizeof interrupted, "%s after %d of %s spp",
-                 murk_cli_stop_name(), res.spp, spp_asked);
-    snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
-    snprintf(secs, sizeof secs, "%.3f", res.seconds);
-    snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res.nonfinite);
+/* The EXR, with the render's murk:* attributes, and its PNG preview: both files or neither. 0, or 1
+ * after the message. */
+static int write_image(const render_args *ra, const murk_scene *s, const murk_render_result *res)
+{
+    char err[2048], spp[32], seed[32], secs[32], nonfinite[32], plugins[4096], interrupted[96] = "no";
+    char spp_asked[32], ranks[32], threads[32], tsecs[32], hash[32], exposure[32], ntiles[32], maxsample[40];
     static char counters[16384];
-    murk_counters_json(s, &res, counters, sizeof counters);
+    const murk_render_opts *o = &ra->opts;
+    snprintf(maxsample, sizeof maxsample, "%.17g", res->max_sample);
+    murk_registry_describe(&s->reg, plugins, sizeof plugins);
+    snprintf(spp, sizeof spp, "%d", res->spp);
+    snprintf(spp_asked, sizeof spp_asked, "%d", o->spp > 0 ? o->spp : s->spp);
+    if (res->interrupted)
+        snprintf(interrupted, sizeof interrupted, "%s after %d of %s spp", murk_cli_stop_name(), res->spp, spp_asked);
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)s->seed);
+    snprintf(secs, sizeof secs, "%.3f", res->seconds);
+    snprintf(nonfinite, sizeof nonfinite, "%llu", (unsigned long long)res->nonfinite);
+    murk_counters_json(s, res, counters, sizeof counters);
+    snprintf(ranks, sizeof ranks, "%d", res->ranks);
+    snprintf(threads, sizeof threads, "%d", res->threads);
+    snprintf(tsecs, sizeof tsecs, "%.3f", res->thread_seconds);
+    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)o->scene_hash);
+    snprintf(exposure, sizeof exposure, "%.9g", (double)s->exposure);
+    snprintf(ntiles, sizeof ntiles, "%d", murk_part_tiles(res->width, res->height, o->part, o->parts));
     murk_kv meta[] = {
-        {"murk:scene", scene_path}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
+        {"murk:scene", ra->scene}, {"murk:spp", spp}, {"murk:seed", seed}, {"murk:render_time", secs},
         {"murk:version", MURK_VERSION}, {"murk:integrator", s->integrator_plugin->desc->name},
-        {"murk:nonfinite_samples", nonfinite}, {"murk:set", setbuf}, {"murk:plugins", plugins},
+        {"murk:nonfinite_samples", nonfinite}, {"murk:set", ra->setbuf}, {"murk:plugins", plugins},
         {"murk:spp_requested", spp_asked}, {"murk:interrupted", interrupted},
-        {"murk:resumed_from", opts.resume ? opts.resume : ""}, {"murk:counters", counters},
+        {"murk:resumed_from", o->resume ? o->resume : ""}, {"murk:counters", counters},
         {"murk:max_sample", maxsample}, /* the largest channel of a finite sample (murk bench --assemble) */
         /* the job: processes, render threads, seconds those threads spent in tiles (summed over ranks) */
         {"murk:ranks", ranks}, {"murk:threads", threads}, {"murk:thread_time", tsecs},
         /* a --part render: what murk merge checks and needs */
-        {"murk:part", parttag}, {"murk:part_split", "tiles"}, {"murk:part_tiles", ntiles},
+        {"murk:part", ra->parttag}, {"murk:part_split", "tiles"}, {"murk:part_tiles", ntiles},
         {"murk:scene_hash", hash}, {"murk:exposure", exposure},
     };
-    snprintf(ranks, sizeof ranks, "%d", res.ranks);
-    snprintf(threads, sizeof threads, "%d", res.threads);
-    snprintf(tsecs, sizeof tsecs, "%.3f", res.thread_seconds);
-    snprintf(hash, sizeof hash, "%016llx", (unsigned long long)opts.scene_hash);
-    snprintf(exposure, sizeof exposure, "%.9g", (double)s->exposure);
-    snprintf(ntiles, sizeof ntiles, "%d", murk_part_tiles(res.width, res.height, opts.part, opts.parts));
-    int nmeta = (int)(sizeof meta / sizeof meta[0]) - (opts.parts ? 0 : 5); /* the murk:part... keys last */
-    char *png = png_path_for(outbuf);
-    int rc = ck_failed ? 1 : 0;
-    if (res.interrupted)
-        fprintf(stderr, "murk: interrupted (%s): writing the image with %d of %s spp%s%s\n",
-                murk_cli_stop_name(), res.spp, spp_asked,
-                opts.checkpoint ? "; resume with --resume " : "", opts.checkpoint ? opts.checkpoint : "");
-    murk_output_begin(); /* the EXR and its PNG: both files or neither */
-    if (murk_exr_write(outbuf, res.rgb, res.width, res.height, meta, nmeta, err, sizeof err) != 0 ||
-        murk_png_write(png, res.rgb, res.width, res.height, s->exposure, err, sizeof err) != 0 ||
+    int nmeta = (int)(sizeof meta / sizeof meta[0]) - (o->parts ? 0 : 5); /* the murk:part... keys last */
+    if (res->interrupted)
+        fprintf(stderr, "murk: interrupted (%s): writing the image with %d of %s spp%s%s\n", murk_cli_stop_name(),
+                res->spp, spp_asked, o->checkpoint ? "; resume with --resume " : "", o->checkpoint ? o->checkpoint : "");
+    murk_output_begin();
+    if (murk_exr_write(ra->exr, res->rgb, res->width, res->height, meta, nmeta, err, sizeof err) != 0 ||
+        murk_png_write(ra->png, res->rgb, res->width, res->height, s->exposure, err, sizeof err) != 0 ||
         murk_output_commit(err, sizeof err) != 0) {
         murk_output_abort();
         cli_error(err);
-        rc = 1;
+        return 1;
     }
+    return 0;
+}
+
+/* Renders the loaded scene, writes its image on rank 0 and says how it went. The exit status. */
+static int render_loaded(render_args *ra, const murk_scene *s, volatile sig_atomic_t *stop)
+{
+    char err[2048];
+    if (identify(ra, s))
+        return 1;
+    ra->opts.progress = !ra->quiet && murk_cli_progress();
+    ra->opts.stop = stop;
+    murk_render_result res;
+    if (murk_render_err(s, &ra->opts, &res, err, sizeof err) != 0) {
+        if (err[0])
+            fprintf(stderr, "murk: %s\n", err);
+        if (!res.rgb)
+            return 1;
+    }
+    int rc = err[0] != 0; /* a checkpoint that failed: the image of the passes done is written, and exit 1 */
+    if (mpi_run.rank > 0) { /* rank 0 writes the image; this rank's status is rank 0's */
+        murk_warn_summary();
+        return 0;
+    }
+    rc |= write_image(ra, s, &res);
     if (res.interrupted || *stop) /* also when the signal came during the writes and cut them short */
         rc = murk_cli_stop_status();
-    if (rc == 0 && !quiet) {
+    if (rc == 0 && !ra->quiet) {
         char sps[32], rps[32];
         human((double)res.samples / res.seconds, sps, sizeof sps);
         human((double)res.rays / res.seconds, rps, sizeof rps);
-        printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", outbuf, png, res.width, res.height, res.spp,
-               res.seconds, sps, rps);
+        printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", ra->exr, ra->png, res.width, res.height,
+               res.spp, res.seconds, sps, rps);
         murk_counters_print(stdout, s, &res);
         murk_cli_memory_print(stdout, s, 0);
     }
@@ -530,11 +554,27 @@ static int render_main(int argc, char **argv)
     if (res.nonfinite)
         murk_log(MURK_LOG_WARN, "integrator '%s' returned %llu NaN or infinite samples; they were left out of their "
                  "pixels", s->integrator_plugin->desc->name, (unsigned long long)res.nonfinite);
-    free(png);
     free(res.rgb);
-    murk_scene_free(s);
-    free(outbuf);
-    free(sets);
+    return rc;
+}
+
+static int render_main(int argc, char **argv)
+{
+    volatile sig_atomic_t *stop = murk_cli_catch_stop_signals();
+    render_args ra;
+    int rc = parse_render_args(&ra, argc, argv);
+    if (rc == 0)
+        rc = check_outputs(&ra);
+    if (rc == 0) {
+        murk_set_quiet(ra.quiet);
+        murk_scene *s = murk_cli_load(ra.scene, ra.sets, ra.nsets);
+        rc = s ? render_loaded(&ra, s, stop) : 1;
+        if (s)
+            murk_scene_free(s);
+    }
+    free(ra.exr);
+    free(ra.png);
+    free(ra.sets);
     return rc;
 }
 
@@ -684,11 +724,11 @@ int murk_cli_main(int argc, char **argv)
     if (!strcmp(cmd, "plugins"))
         return murk_cli_plugins(argc - 2, argv + 2);
     if (!strcmp(cmd, "compare"))
-        return murk_cli_compare(argc - 2, argv + 2);
+        return murk_lab_compare(argc - 2, argv + 2);
     if (!strcmp(cmd, "bench"))
-        return murk_cli_bench(argc - 2, argv + 2);
+        return murk_lab_bench(argc - 2, argv + 2);
     if (!strcmp(cmd, "check"))
-        return murk_check_main(argc - 1, argv + 1);
+        return murk_lab_check(argc - 2, argv + 2);
     if (!strcmp(cmd, "grid"))
         return cmd_grid(argc - 2, argv + 2);
     if (!strcmp(cmd, "merge"))

@@ -89,6 +89,154 @@ static int part_index(const char *v, int *i, int *n)
     return 0;
 }
 
+enum { NSUM = sizeof sum_keys / sizeof sum_keys[0] };
+
+/* A merge under way: the first part (its attributes go to the merged image), the merged pixels, which file
+ * gave each part index, and the figures summed over the parts read. */
+typedef struct merge {
+    const char *const *files;
+    murk_image first;
+    float *rgb;
+    const char **owner; /* the file given for each part index */
+    int n;              /* the number of parts of the render */
+    double sums[NSUM];
+    double max_sample;     /* the largest murk:max_sample */
+    char counters[16384]; /* murk:counters summed over the parts ("" when not of one shape) */
+} merge;
+
+/* Part p (files[k]) is a whole part of the first one's render, one not given before; its index into *i.
+ * 0, or 1 after the message. The first part sets the number of parts and the image's size. */
+static int check_part(merge *m, int k, const murk_image *p, int *i)
+{
+    const char *file = m->files[k];
+    int nn;
+    if (part_index(murk_image_meta(p, "murk:part"), i, &nn) != 0)
+        return merge_fail("murk: %s: not a part of a murk render --part I/N (no murk:part attribute)\n", file, NULL,
+                          NULL, NULL);
+    const char *why = murk_image_meta(p, "murk:interrupted");
+    if (!why || strcmp(why, "no") != 0)
+        return merge_fail("murk: %s: part %s was interrupted (%s): render it again (or resume its checkpoint)\n", file,
+                          murk_image_meta(p, "murk:part"), why ? why : "murk:interrupted missing", NULL);
+    if (k == 0) {
+        m->n = nn;
+        m->owner = murk_xmalloc((size_t)nn * sizeof *m->owner);
+        m->rgb = murk_xmalloc(3 * sizeof(float) * (size_t)p->w * (size_t)p->h);
+    } else {
+        const char *diff = nn != m->n ? "murk:part" : p->w != m->first.w || p->h != m->first.h ? "the resolution" : NULL;
+        for (size_t s = 0; !diff && s < sizeof same_keys / sizeof same_keys[0]; s++)
+            if (strcmp(meta_or_empty(p, same_keys[s]), meta_or_empty(&m->first, same_keys[s])) != 0)
+                diff = same_keys[s];
+        if (diff)
+            return merge_fail("murk: %s: is a part of another render than %s (%s differs); merge the parts of one "
+                              "render\n", file, m->files[0], diff, NULL);
+        if (m->owner[*i]) {
+            char idx[64];
+            snprintf(idx, sizeof idx, "%d/%d", *i, m->n);
+            return merge_fail("murk: %s: part %s is given twice (also %s)\n", file, idx, m->owner[*i], NULL);
+        }
+    }
+    char tiles[32];
+    snprintf(tiles, sizeof tiles, "%d", murk_part_tiles(p->w, p->h, *i, m->n));
+    if (strcmp(meta_or_empty(p, "murk:part_tiles"), tiles) != 0)
+        return merge_fail("murk: %s: murk:part_tiles is '%s', but part %s of this image has %s tiles\n", file,
+                          meta_or_empty(p, "murk:part_tiles"), murk_image_meta(p, "murk:part"), tiles);
+    return 0;
+}
+
+/* Part i (files[k], p) into the merged image: its tiles' pixels, its times and counts. */
+static void add_part(merge *m, int k, const murk_image *p, int i)
+{
+    m->owner[i] = m->files[k];
+    for (int y = 0; y < p->h; y++)
+        for (int x = 0; x < p->w; x++)
+            if (murk_part_of(p->w, x, y, m->n) == i)
+                memcpy(m->rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x),
+                       p->rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x), 3 * sizeof(float));
+    for (size_t s = 0; s < NSUM; s++)
+        m->sums[s] += strtod(meta_or_empty(p, sum_keys[s]), NULL);
+    if (strtod(meta_or_empty(p, "murk:max_sample"), NULL) > m->max_sample)
+        m->max_sample = strtod(meta_or_empty(p, "murk:max_sample"), NULL);
+    if (k == 0)
+        snprintf(m->counters, sizeof m->counters, "%s", meta_or_empty(p, "murk:counters"));
+    else if (json_add(m->counters, sizeof m->counters, meta_or_empty(p, "murk:counters")) != 0)
+        m->counters[0] = 0; /* not of one shape: left out rather than wrong */
+}
+
+/* Reads, checks and adds every part, one at a time; then every index must have its part. 0, or 1. */
+static int read_parts(merge *m, int nparts)
+{
+    char err[2048];
+    for (int k = 0; k < nparts; k++) {
+        murk_image img = {0}, *p = k ? &img : &m->first;
+        int i, rc = 0;
+        if (murk_exr_read(m->files[k], p, err, sizeof err) != 0)
+            rc = merge_fail("murk: %s\n", err, NULL, NULL, NULL);
+        else if ((rc = check_part(m, k, p, &i)) == 0)
+            add_part(m, k, p, i);
+        murk_image_free(&img);
+        if (rc)
+            return rc;
+    }
+    for (int i = 0; i < m->n; i++)
+        if (!m->owner[i]) {
+            char idx[64];
+            snprintf(idx, sizeof idx, "%d/%d", i, m->n);
+            merge_fail("murk: part %s is missing: render it with --part %s and merge again\n", idx, idx, NULL, NULL);
+            fprintf(stderr, "murk: given:");
+            for (int k = 0; k < m->n; k++)
+                if (m->owner[k])
+                    fprintf(stderr, " %d:%s", k, m->owner[k]);
+            fputc('\n', stderr);
+            return 1;
+        }
+    return 0;
+}
+
+/* The merged EXR, with the first part's murk:* attributes (but a part's own), the sums, the largest
+ * sample and the counters, and its PNG preview: both files or neither. 0, or 1 after the message. */
+static int write_merged(merge *m, const char *out, const char *png)
+{
+    size_t nm = (size_t)m->first.nmeta, k = 0;
+    murk_kv *meta = murk_xmalloc((nm + 1) * sizeof *meta);
+    char vals[NSUM][64], maxs[40], merged[64], err[2048];
+    for (size_t a = 0; a < nm; a++) {
+        const char *key = m->first.meta[a].key, *val = m->first.meta[a].value;
+        int skip = strncmp(key, "murk:", 5) != 0; /* the file's own attributes are the writer's */
+        for (size_t s = 0; s < sizeof part_keys / sizeof part_keys[0]; s++)
+            skip |= !strcmp(key, part_keys[s]);
+        if (!strcmp(key, "murk:max_sample")) {
+            snprintf(maxs, sizeof maxs, "%.17g", m->max_sample);
+            val = maxs;
+        }
+        if (!strcmp(key, "murk:counters")) {
+            skip |= !m->counters[0];
+            val = m->counters;
+        }
+        for (size_t s = 0; s < NSUM; s++)
+            if (!strcmp(key, sum_keys[s])) {
+                snprintf(vals[s], sizeof vals[s], strchr(val, '.') ? "%.3f" : "%.0f", m->sums[s]);
+                val = vals[s];
+            }
+        if (!skip)
+            meta[k++] = (murk_kv){key, val};
+    }
+    snprintf(merged, sizeof merged, "%d parts", m->n);
+    meta[k++] = (murk_kv){"murk:merged_from", merged};
+    float exposure = strtof(meta_or_empty(&m->first, "murk:exposure"), NULL);
+    int rc = 0;
+    murk_output_begin();
+    if (murk_exr_write(out, m->rgb, m->first.w, m->first.h, meta, (int)k, err, sizeof err) != 0 ||
+        murk_png_write(png, m->rgb, m->first.w, m->first.h, exposure, err, sizeof err) != 0 ||
+        murk_output_commit(err, sizeof err) != 0) {
+        murk_output_abort();
+        rc = merge_fail("murk: %s\n", err, NULL, NULL, NULL);
+    } else {
+        printf("%s, %s: %dx%d, %d parts merged\n", out, png, m->first.w, m->first.h, m->n);
+    }
+    free(meta);
+    return rc;
+}
+
 int murk_cli_merge(int argc, char **argv)
 {
     const char *out = NULL;
@@ -115,147 +263,19 @@ int murk_cli_merge(int argc, char **argv)
     char err[2048], *png = murk_xmalloc(ol + 1);
     memcpy(png, out, ol - 4);
     memcpy(png + ol - 4, ".png", 5);
-    if (murk_output_check(out, err, sizeof err) || murk_output_check(png, err, sizeof err)) {
-        merge_fail("murk: %s\n", err, NULL, NULL, NULL);
-        free(png);
-        free(parts);
-        return 1;
-    }
-
-    murk_image first = {0}, img = {0};
-    float *rgb = NULL;
-    const char **owner = NULL; /* the file given for each part index */
-    double sums[sizeof sum_keys / sizeof sum_keys[0]] = {0};
-    static char counters[16384]; /* murk:counters summed over the parts */
-    double max_sample = 0;         /* and the largest of their murk:max_sample */
-    char maxs[40];
-    int n = 0, rc = 0;
-    for (int k = 0; k < nparts && rc == 0; k++) {
-        murk_image *p = k ? &img : &first;
-        int i, nn;
-        if (murk_exr_read(parts[k], p, err, sizeof err) != 0) {
-            rc = merge_fail("murk: %s\n", err, NULL, NULL, NULL);
-            break;
-        }
-        if (part_index(murk_image_meta(p, "murk:part"), &i, &nn) != 0) {
-            rc = merge_fail("murk: %s: not a part of a murk render --part I/N (no murk:part attribute)\n", parts[k],
-                            NULL, NULL, NULL);
-            break;
-        }
-        const char *why = murk_image_meta(p, "murk:interrupted");
-        if (!why || strcmp(why, "no") != 0) {
-            rc = merge_fail("murk: %s: part %s was interrupted (%s): render it again (or resume its checkpoint)\n",
-                            parts[k], murk_image_meta(p, "murk:part"), why ? why : "murk:interrupted missing", NULL);
-            break;
-        }
-        if (k == 0) {
-            n = nn;
-            owner = murk_xmalloc((size_t)n * sizeof *owner);
-            rgb = murk_xmalloc(3 * sizeof(float) * (size_t)p->w * (size_t)p->h);
-        } else {
-            char what[64];
-            const char *diff = NULL;
-            if (nn != n)
-                diff = "murk:part";
-            else if (p->w != first.w || p->h != first.h)
-                diff = "the resolution";
-            for (size_t s = 0; !diff && s < sizeof same_keys / sizeof same_keys[0]; s++)
-                if (strcmp(meta_or_empty(p, same_keys[s]), meta_or_empty(&first, same_keys[s])) != 0)
-                    diff = same_keys[s];
-            if (diff) {
-                snprintf(what, sizeof what, "%s", diff);
-                rc = merge_fail("murk: %s: is a part of another render than %s (%s differs); merge the parts of "
-                                "one render\n", parts[k], parts[0], what, NULL);
-                break;
-            }
-            if (owner[i]) {
-                char idx[64];
-                snprintf(idx, sizeof idx, "%d/%d", i, n);
-                rc = merge_fail("murk: %s: part %s is given twice (also %s)\n", parts[k], idx, owner[i], NULL);
-                break;
-            }
-        }
-        char tiles[32];
-        snprintf(tiles, sizeof tiles, "%d", murk_part_tiles(p->w, p->h, i, n));
-        if (strcmp(meta_or_empty(p, "murk:part_tiles"), tiles) != 0) {
-            rc = merge_fail("murk: %s: murk:part_tiles is '%s', but part %s of this image has %s tiles\n", parts[k],
-                            meta_or_empty(p, "murk:part_tiles"), murk_image_meta(p, "murk:part"), tiles);
-            break;
-        }
-        owner[i] = parts[k];
-        for (int y = 0; y < p->h; y++)
-            for (int x = 0; x < p->w; x++)
-                if (murk_part_of(p->w, x, y, n) == i)
-                    memcpy(rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x),
-                           p->rgb + 3 * ((size_t)y * (size_t)p->w + (size_t)x), 3 * sizeof(float));
-        for (size_t s = 0; s < sizeof sum_keys / sizeof sum_keys[0]; s++)
-            sums[s] += strtod(meta_or_empty(p, sum_keys[s]), NULL);
-        if (strtod(meta_or_empty(p, "murk:max_sample"), NULL) > max_sample)
-            max_sample = strtod(meta_or_empty(p, "murk:max_sample"), NULL);
-        if (k == 0)
-            snprintf(counters, sizeof counters, "%s", meta_or_empty(p, "murk:counters"));
-        else if (json_add(counters, sizeof counters, meta_or_empty(p, "murk:counters")) != 0)
-            counters[0] = 0; /* not of one shape: left out rather than wrong */
-        if (k)
-            murk_image_free(&img);
-    }
-    for (int i = 0; i < n && rc == 0; i++)
-        if (!owner[i]) {
-            char idx[64];
-            snprintf(idx, sizeof idx, "%d/%d", i, n);
-            rc = merge_fail("murk: part %s is missing: render it with --part %s and merge again\n", idx, idx, NULL,
-                            NULL);
-            fprintf(stderr, "murk: given:");
-            for (int k = 0; k < n; k++)
-                if (owner[k])
-                    fprintf(stderr, " %d:%s", k, owner[k]);
-            fputc('\n', stderr);
-        }
-    if (rc == 0) {
-        size_t nm = (size_t)first.nmeta, m = 0;
-        murk_kv *meta = murk_xmalloc((nm + 1) * sizeof *meta);
-        char (*vals)[64] = murk_xmalloc(sizeof sum_keys / sizeof sum_keys[0] * sizeof *vals);
-        for (size_t a = 0; a < nm; a++) {
-            const char *key = first.meta[a].key, *val = first.meta[a].value;
-            int skip = strncmp(key, "murk:", 5) != 0; /* the file's own attributes are the writer's */
-            for (size_t s = 0; s < sizeof part_keys / sizeof part_keys[0]; s++)
-                skip |= !strcmp(key, part_keys[s]);
-            if (!strcmp(key, "murk:max_sample")) {
-                snprintf(maxs, sizeof maxs, "%.17g", max_sample);
-                val = maxs;
-            }
-            if (!strcmp(key, "murk:counters")) {
-                skip |= !counters[0];
-                val = counters;
-            }
-            for (size_t s = 0; s < sizeof sum_keys / sizeof sum_keys[0]; s++)
-                if (!strcmp(key, sum_keys[s])) {
-                    snprintf(vals[s], sizeof vals[s], strchr(val, '.') ? "%.3f" : "%.0f", sums[s]);
-                    val = vals[s];
-                }
-            if (!skip)
-                meta[m++] = (murk_kv){key, val};
-        }
-        char merged[64];
-        snprintf(merged, sizeof merged, "%d parts", n);
-        meta[m++] = (murk_kv){"murk:merged_from", merged};
-        float exposure = strtof(meta_or_empty(&first, "murk:exposure"), NULL);
-        murk_output_begin();
-        if (murk_exr_write(out, rgb, first.w, first.h, meta, (int)m, err, sizeof err) != 0 ||
-            murk_png_write(png, rgb, first.w, first.h, exposure, err, sizeof err) != 0 ||
-            murk_output_commit(err, sizeof err) != 0) {
-            murk_output_abort();
-            rc = merge_fail("murk: %s\n", err, NULL, NULL, NULL);
-        } else {
-            printf("%s, %s: %dx%d, %d parts merged\n", out, png, first.w, first.h, n);
-        }
-        free(vals);
-        free(meta);
-    }
-    murk_image_free(&first);
-    murk_image_free(&img);
-    free(owner);
-    free(rgb);
+    int rc = 0;
+    merge *m = murk_xmalloc(sizeof *m);
+    m->files = parts;
+    if (murk_output_probe(out, "image", err, sizeof err) || murk_output_probe(png, "PNG preview", err, sizeof err))
+        rc = merge_fail("murk: %s\n", err, NULL, NULL, NULL);
+    if (rc == 0)
+        rc = read_parts(m, nparts);
+    if (rc == 0)
+        rc = write_merged(m, out, png);
+    murk_image_free(&m->first);
+    free(m->owner);
+    free(m->rgb);
+    free(m);
     free(png);
     free(parts);
     return rc;

@@ -107,7 +107,7 @@ murk_field *murk_field_adopt(const char *path, const int res[3], const int origi
     return f;
 }
 
-murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi, const float *data)
+MURK_API murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk_vec3 hi, const float *data)
 {
     uint64_t n = murk_voxel_count(res[0], res[1], res[2]);
     if (n == 0 || !murk_box_ok(lo, hi))

@@ -82,13 +82,96 @@ static int dropped_by_swap(const murk_ynode *map, size_t k, uint32_t kind, const
     return took;
 }
 
+/* The message for map's key k, which d does not take: a suggestion, or where to look. Returns -1. */
+static int unknown_key(const murk_plugin_desc *d, const murk_ynode *map, size_t k, const char *who,
+                       const char *const *skip, size_t nskip, char *err, size_t errlen)
+{
+    const char *key = map->keys[k], *cand[96];
+    size_t nc = 0;
+    for (uint32_t i = 0; i < d->nparams && nc < 96; i++)
+        cand[nc++] = d->params[i].name;
+    for (size_t j = 0; j < nskip && nc < 96; j++)
+        cand[nc++] = skip[j];
+    const char *sug = murk_did_you_mean(key, cand, nc);
+    char hint[160];
+    if (sug)
+        snprintf(hint, sizeof hint, "did you mean '%s'?", sug);
+    else
+        snprintf(hint, sizeof hint, "see: murk plugins %s", d->name);
+    if (murk_yfrom_set(map->items[k]->file) && !murk_yfrom_set(map->key_file[k])) /* a --set's value */
+        return murk_yerr(err, errlen, map->items[k], "unknown parameter '%s' for %s (%s)", key, who, hint);
+    return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (%s)", key, who, hint);
+}
+
+/* A float or colour parameter given as a texture (a map): parsed, kept by the scene, its average as the
+ * plain value. 0, or -1 with "LOCATION: WHAT: message" in err. */
+static int read_texture(murk_scene *s, const murk_param *p, murk_value *v, const murk_ynode *n, const char *what,
+                        char *err, size_t errlen)
+{
+    murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
+    if (!t) { /* name the parameter after the location: "LOCATION: WHO: message" */
+        char msg[2048];
+        size_t at = location_length(&s->doc, err);
+        snprintf(msg, sizeof msg, "%.*s%s: %s", (int)at, err, what, err + at);
+        snprintf(err, errlen, "%s", msg);
+        return -1;
+    }
+    s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
+    s->textures[s->ntextures++] = t;
+    v->tex = t;
+    murk_texture_average(t, v->f);
+    return 0;
+}
+
+/* Node n as the value of parameter p (its schema entry) into v; `what` names it in messages. 0, or -1. */
+static int read_value(murk_scene *s, const murk_param *p, murk_value *v, const murk_ynode *n, const char *what,
+                      char *err, size_t errlen)
+{
+    long long iv = 0;
+    int bv = 0;
+    v->set = 1;
+    switch (p->type) {
+    case MURK_PARAM_FLOAT:
+    case MURK_PARAM_RGB:
+        if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE))
+            return read_texture(s, p, v, n, what, err, errlen);
+        if (n->kind == MURK_Y_MAP)
+            return ERR(n, "%s does not take a texture", what);
+        if (p->type == MURK_PARAM_RGB)
+            return murk_yread_rgb(n, what, p->min, p->max, v->f, err, errlen) ? -1 : 0;
+        if (murk_yread_range(n, what, p->min, p->max, &v->f[0], err, errlen))
+            return -1;
+        v->f[1] = v->f[2] = v->f[0];
+        return 0;
+    case MURK_PARAM_INT:
+        if (murk_yread_int(n, what, p->min, p->max, &iv, err, errlen))
+            return -1;
+        v->f[0] = (double)iv;
+        return 0;
+    case MURK_PARAM_BOOL:
+        if (murk_yread_bool(n, what, &bv, err, errlen))
+            return -1;
+        v->f[0] = bv;
+        return 0;
+    case MURK_PARAM_STRING:
+        return murk_yread_string(n, what, &v->s, err, errlen) ? -1 : 0;
+    case MURK_PARAM_ENUM:
+        if (n->kind != MURK_Y_SCALAR || (v->choice = choice_index(p->choices, n->str)) < 0)
+            return ERR(n, "%s must be one of %s, got '%s'", what, p->choices, n->kind == MURK_Y_SCALAR ? n->str : "a list");
+        v->s = n->str;
+        return 0;
+    default:
+        return ERR(n, "%s has an unknown type", what);
+    }
+}
+
 /* Fills values[] in schema order from the map's keys (all keys but those in skip[]). `who` names the
  * block in messages, e.g. "material 'metal' (ggx)". */
 int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, const murk_ynode *map, const char *who,
                                   const char *const *skip, size_t nskip, int note_drops, murk_value *values, char *err,
                                   size_t errlen)
 {
-    for (uint32_t i = 0; i < d->nparams; i++) {
+    for (uint32_t i = 0; i < d->nparams; i++) { /* the defaults */
         const murk_param *p = &d->params[i];
         murk_value *v = &values[i];
         memset(v, 0, sizeof *v);
@@ -110,79 +193,12 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
                 idx = (int)i;
         if (idx < 0 && dropped_by_swap(map, k, d->kind, who, note_drops))
             continue;
-        if (idx < 0) {
-            const char *cand[96];
-            size_t nc = 0;
-            for (uint32_t i = 0; i < d->nparams && nc < 96; i++)
-                cand[nc++] = d->params[i].name;
-            for (size_t j = 0; j < nskip && nc < 96; j++)
-                cand[nc++] = skip[j];
-            const char *sug = murk_did_you_mean(key, cand, nc);
-            char hint[160];
-            if (sug)
-                snprintf(hint, sizeof hint, "did you mean '%s'?", sug);
-            else
-                snprintf(hint, sizeof hint, "see: murk plugins %s", d->name);
-            if (murk_yfrom_set(map->items[k]->file) && !murk_yfrom_set(map->key_file[k])) /* a --set's value */
-                return murk_yerr(err, errlen, map->items[k], "unknown parameter '%s' for %s (%s)", key, who, hint);
-            return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (%s)", key, who, hint);
-        }
-        const murk_param *p = &d->params[idx];
-        murk_value *v = &values[idx];
-        const murk_ynode *n = map->items[k];
+        if (idx < 0)
+            return unknown_key(d, map, k, who, skip, nskip, err, errlen);
         char what[256];
         snprintf(what, sizeof what, "%s: parameter '%s'", who, key);
-        v->set = 1;
-        long long iv = 0;
-        int bv = 0;
-        switch (p->type) {
-        case MURK_PARAM_FLOAT:
-        case MURK_PARAM_RGB:
-            if (n->kind == MURK_Y_MAP && (p->flags & MURK_PARAM_TEXTURABLE)) {
-                murk_texture *t = murk_texture_parse(n, s->doc.file, p->min, p->max, err, errlen);
-                if (!t) { /* name the parameter after the location: "LOCATION: WHO: message" */
-                    char msg[2048];
-                    size_t at = location_length(&s->doc, err);
-                    snprintf(msg, sizeof msg, "%.*s%s: %s", (int)at, err, what, err + at);
-                    snprintf(err, errlen, "%s", msg);
-                    return -1;
-                }
-                s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
-                s->textures[s->ntextures++] = t;
-                v->tex = t;
-                murk_texture_average(t, v->f);
-            } else if (n->kind == MURK_Y_MAP) {
-                return ERR(n, "%s does not take a texture", what);
-            } else if (p->type == MURK_PARAM_FLOAT) {
-                if (murk_yread_range(n, what, p->min, p->max, &v->f[0], err, errlen))
-                    return -1;
-                v->f[1] = v->f[2] = v->f[0];
-            } else if (murk_yread_rgb(n, what, p->min, p->max, v->f, err, errlen)) {
-                return -1;
-            }
-            break;
-        case MURK_PARAM_INT:
-            if (murk_yread_int(n, what, p->min, p->max, &iv, err, errlen))
-                return -1;
-            v->f[0] = (double)iv;
-            break;
-        case MURK_PARAM_BOOL:
-            if (murk_yread_bool(n, what, &bv, err, errlen))
-                return -1;
-            v->f[0] = bv;
-            break;
-        case MURK_PARAM_STRING:
-            if (murk_yread_string(n, what, &v->s, err, errlen))
-                return -1;
-            break;
-        case MURK_PARAM_ENUM:
-            if (n->kind != MURK_Y_SCALAR || (v->choice = choice_index(p->choices, n->str)) < 0)
-                return ERR(n, "%s must be one of %s, got '%s'", what, p->choices, n->kind == MURK_Y_SCALAR ? n->str : "a list");
-            v->s = n->str;
-            break;
-        default:
-            return ERR(n, "%s has an unknown type", what);
-        }
+        if (read_value(s, &d->params[idx], &values[idx], map->items[k], what, err, errlen))
+            return -1;
     }
     for (uint32_t i = 0; i < d->nparams; i++)
         if ((d->params[i].flags & MURK_PARAM_REQUIRED) && !values[i].set)

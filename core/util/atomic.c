@@ -207,6 +207,38 @@ MURK_API int murk_write_atomic(const char *path, murk_write_fn fill, void *user,
     return rc;
 }
 
+MURK_API int murk_output_probe(const char *path, const char *what, char *err, size_t errlen)
+{
+    if (murk_output_check(path, err, errlen) != 0)
+        return -1;
+    char *tmp = tmp_name(path);
+    if (!tmp)
+        return murk_err_file(err, errlen, path, "out of memory");
+    if (pending_find(tmp) >= 0) { /* this process is writing it right now */
+        free(tmp);
+        return 0;
+    }
+    int rc = 0;
+    if (pending_add(tmp, path) != 0) {
+        free(tmp);
+        return murk_err_file(err, errlen, path, "too many output files at once");
+    }
+    int slot = pending_find(tmp);
+    /* as murk_write_atomic does: a stale temporary of this pid goes, the new one is never a link */
+    int fd = -1;
+    if (unlink(tmp) == 0 || errno == ENOENT)
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd < 0)
+        rc = murk_err_file(err, errlen, path, "cannot write the %s: %s", what, strerror(errno));
+    else {
+        close(fd);
+        unlink(tmp);
+    }
+    pending_drop(slot);
+    free(tmp);
+    return rc;
+}
+
 MURK_API void murk_output_begin(void) { group_open = 1; }
 
 MURK_API void murk_output_abort(void)

@@ -30,6 +30,10 @@ int murk_write_atomic(const char *path, murk_write_fn fill, void *user, char *er
 
 /* 0 if path does not exist or is a regular file murk may replace; else -1 with err naming what it is. */
 int murk_output_check(const char *path, char *err, size_t errlen);
+/* murk_output_check, then whether murk_write_atomic could write path now: its temporary is created and
+ * removed again (the target is not touched). 0, or -1 with err = "path: cannot write the WHAT: why" (what:
+ * "image", "checkpoint", ...). For checking every output before a long render rather than after it. */
+int murk_output_probe(const char *path, const char *what, char *err, size_t errlen);
 /* Starts a group: until commit or abort, murk_write_atomic leaves its finished temporaries in place. */
 void murk_output_begin(void);
 /* Renames every temporary of the group over its target (all or none); 0, or -1 with err. Ends the group. */

@@ -98,7 +98,7 @@ char *murk_path_relative_to(const char *path, const char *rel)
     return out;
 }
 
-double murk_now(void)
+MURK_API double murk_now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);

@@ -90,152 +90,164 @@ int murk_yerr_key(char *err, size_t errlen, const murk_ynode *map, size_t i, con
 /* Builds the tree from the parser's events. Depth is bounded so hostile input can't blow the stack. */
 enum { MAX_DEPTH = 64 };
 
-static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t textlen, const char *file,
-                        murk_ynode **root, char *err, size_t errlen)
-{
+/* The tree being built: the open containers and, for each open map, the key waiting for its value. */
+typedef struct builder {
+    const char *file;
     murk_ynode *stack[MAX_DEPTH];
     char *pending_key[MAX_DEPTH];
     int pk_line[MAX_DEPTH], pk_col[MAX_DEPTH];
-    int depth = 0, docs = 0, rc = 0;
-    *root = NULL;
-    for (;;) {
+    int depth, docs;
+    murk_ynode *root;
+} builder;
+
+/* The parser's error at its place in the file. */
+static void parse_error(const yaml_parser_t *p, const unsigned char *text, size_t textlen, const char *file,
+                        char *err, size_t errlen)
+{
+    int line = (int)p->problem_mark.line + 1, col = (int)p->problem_mark.column + 1;
+    const char *prob = p->problem ? p->problem : "malformed YAML";
+    int tab = 0;
+    if (p->error == YAML_READER_ERROR) {
+        /* encoding errors come as a byte offset, not a mark: count lines and characters */
+        size_t off = p->problem_offset < textlen ? p->problem_offset : textlen;
+        line = col = 1;
+        for (size_t i = 0; i < off; i++) {
+            if (text[i] == '\n')
+                line++, col = 1;
+            else if ((text[i] & 0xC0) != 0x80)
+                col++;
+        }
+    } else if (p->problem_mark.index < textlen && text[p->problem_mark.index] == '\t') {
+        /* libyaml says "cannot start any token" of a tab used for indentation: say so plainly */
+        prob = "tab character: YAML indentation must use spaces";
+        tab = 1;
+    }
+    if (p->context && !tab)
+        murk_err_at(err, errlen, file, line, col, "%s %s", prob, p->context);
+    else
+        murk_err_at(err, errlen, file, line, col, "%s", prob);
+}
+
+/* A scalar where the open map waits for a key: it becomes that key (node is freed). 0, or -1 with err. */
+static int take_key(builder *b, murk_ynode *node, char *err, size_t errlen)
+{
+    int d = b->depth - 1, rc = 0;
+    if (node->kind != MURK_Y_SCALAR)
+        rc = murk_err_at(err, errlen, b->file, node->line, node->col, "a map key must be a plain name");
+    else if (murk_ymap_get(b->stack[d], node->str))
+        rc = murk_err_at(err, errlen, b->file, node->line, node->col, "duplicate key '%s'", node->str);
+    else {
+        b->pending_key[d] = node->str;
+        b->pk_line[d] = node->line;
+        b->pk_col[d] = node->col;
+        node->str = NULL;
+    }
+    murk_ynode_free(node);
+    return rc;
+}
+
+/* A new node in its place: the root, a map's key, a value of the open container, or (a container) the
+ * new open one. 0, or -1 with err set (node freed). */
+static int place(builder *b, murk_ynode *node, char *err, size_t errlen)
+{
+    int container = node->kind != MURK_Y_SCALAR, d = b->depth - 1;
+    if (b->depth == 0 && !container) {
+        b->root = node;
+        return 0;
+    }
+    if (b->depth > 0 && b->stack[d]->kind == MURK_Y_MAP && !b->pending_key[d])
+        return take_key(b, node, err, errlen);
+    if (container) {
+        if (b->depth >= MAX_DEPTH) {
+            murk_err_at(err, errlen, b->file, node->line, node->col, "nesting deeper than %d levels", MAX_DEPTH);
+            murk_ynode_free(node);
+            return -1;
+        }
+        b->stack[b->depth] = node;
+        b->pending_key[b->depth] = NULL;
+        b->depth++;
+    } else if (b->stack[d]->kind == MURK_Y_MAP) {
+        append(b->stack[d], node, b->pending_key[d], b->file, b->pk_line[d], b->pk_col[d]);
+        b->pending_key[d] = NULL;
+    } else {
+        append(b->stack[d], node, NULL, NULL, 0, 0);
+    }
+    return 0;
+}
+
+/* The end of the open container: the root, or a value of the container around it. */
+static void close_container(builder *b)
+{
+    murk_ynode *top = b->stack[--b->depth];
+    int d = b->depth - 1;
+    if (b->depth == 0) {
+        b->root = top;
+        return;
+    }
+    append(b->stack[d], top, b->pending_key[d], b->file, b->pk_line[d], b->pk_col[d]);
+    b->pending_key[d] = NULL;
+}
+
+/* One event: 1 at the end of the stream, 0 to go on, -1 with err set. */
+static int on_event(builder *b, const yaml_event_t *ev, char *err, size_t errlen)
+{
+    int line = (int)ev->start_mark.line + 1, col = (int)ev->start_mark.column + 1;
+    murk_ynode *node;
+    switch (ev->type) {
+    case YAML_STREAM_END_EVENT:
+        return 1;
+    case YAML_DOCUMENT_START_EVENT:
+        if (++b->docs > 1)
+            return murk_err_at(err, errlen, b->file, line, col, "a scene file holds one YAML document");
+        return 0;
+    case YAML_ALIAS_EVENT:
+        return murk_err_at(err, errlen, b->file, line, col, "YAML aliases are not supported in scenes");
+    case YAML_SCALAR_EVENT:
+        node = murk_ynode_new(MURK_Y_SCALAR, b->file, line, col);
+        node->str = murk_strdup((const char *)ev->data.scalar.value);
+        node->plain = ev->data.scalar.style == YAML_PLAIN_SCALAR_STYLE;
+        return place(b, node, err, errlen);
+    case YAML_SEQUENCE_START_EVENT:
+    case YAML_MAPPING_START_EVENT:
+        node = murk_ynode_new(ev->type == YAML_SEQUENCE_START_EVENT ? MURK_Y_SEQ : MURK_Y_MAP, b->file, line, col);
+        return place(b, node, err, errlen);
+    case YAML_SEQUENCE_END_EVENT:
+    case YAML_MAPPING_END_EVENT:
+        close_container(b);
+        return 0;
+    default:
+        return 0;
+    }
+}
+
+static int parse_events(yaml_parser_t *p, const unsigned char *text, size_t textlen, const char *file,
+                        murk_ynode **root, char *err, size_t errlen)
+{
+    builder b = {.file = file};
+    int rc = 0;
+    while (rc == 0) {
         yaml_event_t ev;
         if (!yaml_parser_parse(p, &ev)) {
-            int line = (int)p->problem_mark.line + 1, col = (int)p->problem_mark.column + 1;
-            const char *prob = p->problem ? p->problem : "malformed YAML";
-            int tab = 0;
-            if (p->error == YAML_READER_ERROR) {
-                /* encoding errors come as a byte offset, not a mark: count lines and characters */
-                size_t off = p->problem_offset < textlen ? p->problem_offset : textlen;
-                line = col = 1;
-                for (size_t i = 0; i < off; i++) {
-                    if (text[i] == '\n')
-                        line++, col = 1;
-                    else if ((text[i] & 0xC0) != 0x80)
-                        col++;
-                }
-            } else if (p->problem_mark.index < textlen && text[p->problem_mark.index] == '\t') {
-                /* libyaml says "cannot start any token" of a tab used for indentation: say so plainly */
-                prob = "tab character: YAML indentation must use spaces";
-                tab = 1;
-            }
-            if (p->context && !tab)
-                murk_err_at(err, errlen, file, line, col, "%s %s", prob, p->context);
-            else
-                murk_err_at(err, errlen, file, line, col, "%s", prob);
+            parse_error(p, text, textlen, file, err, errlen);
             rc = -1;
             break;
         }
-        int line = (int)ev.start_mark.line + 1, col = (int)ev.start_mark.column + 1;
-        murk_ynode *node = NULL;
-        int done = 0;
-        switch (ev.type) {
-        case YAML_STREAM_END_EVENT:
-            done = 1;
-            break;
-        case YAML_DOCUMENT_START_EVENT:
-            if (++docs > 1) {
-                murk_err_at(err, errlen, file, line, col, "a scene file holds one YAML document");
-                rc = -1;
-                done = 1;
-            }
-            break;
-        case YAML_ALIAS_EVENT:
-            murk_err_at(err, errlen, file, line, col, "YAML aliases are not supported in scenes");
-            rc = -1;
-            done = 1;
-            break;
-        case YAML_SCALAR_EVENT:
-            node = murk_ynode_new(MURK_Y_SCALAR, file, line, col);
-            node->str = murk_strdup((const char *)ev.data.scalar.value);
-            node->plain = ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE;
-            break;
-        case YAML_SEQUENCE_START_EVENT:
-        case YAML_MAPPING_START_EVENT:
-            node = murk_ynode_new(ev.type == YAML_SEQUENCE_START_EVENT ? MURK_Y_SEQ : MURK_Y_MAP, file, line, col);
-            break;
-        case YAML_SEQUENCE_END_EVENT:
-        case YAML_MAPPING_END_EVENT: {
-            murk_ynode *top = stack[--depth];
-            if (depth == 0) {
-                *root = top;
-            } else {
-                murk_ynode *parent = stack[depth - 1];
-                append(parent, top, pending_key[depth - 1], file, pk_line[depth - 1], pk_col[depth - 1]);
-                pending_key[depth - 1] = NULL;
-            }
-            break;
-        }
-        default:
-            break;
-        }
-        if (node) {
-            int container = node->kind != MURK_Y_SCALAR;
-            if (depth == 0) {
-                if (container) {
-                    stack[depth++] = node;
-                    pending_key[0] = NULL;
-                } else {
-                    *root = node;
-                }
-            } else {
-                murk_ynode *parent = stack[depth - 1];
-                if (parent->kind == MURK_Y_MAP && !pending_key[depth - 1]) {
-                    /* this node is a key */
-                    if (container) {
-                        murk_err_at(err, errlen, file, line, col, "a map key must be a plain name");
-                        murk_ynode_free(node);
-                        rc = -1;
-                        done = 1;
-                    } else {
-                        if (murk_ymap_get(parent, node->str)) {
-                            murk_err_at(err, errlen, file, line, col, "duplicate key '%s'", node->str);
-                            murk_ynode_free(node);
-                            rc = -1;
-                            done = 1;
-                        } else {
-                            pending_key[depth - 1] = node->str;
-                            pk_line[depth - 1] = node->line;
-                            pk_col[depth - 1] = node->col;
-                            node->str = NULL;
-                            murk_ynode_free(node);
-                        }
-                    }
-                } else if (container) {
-                    if (depth >= MAX_DEPTH) {
-                        murk_err_at(err, errlen, file, line, col, "nesting deeper than %d levels", MAX_DEPTH);
-                        murk_ynode_free(node);
-                        rc = -1;
-                        done = 1;
-                    } else {
-                        stack[depth] = node;
-                        pending_key[depth] = NULL;
-                        depth++;
-                    }
-                } else if (parent->kind == MURK_Y_MAP) {
-                    append(parent, node, pending_key[depth - 1], file, pk_line[depth - 1], pk_col[depth - 1]);
-                    pending_key[depth - 1] = NULL;
-                } else {
-                    append(parent, node, NULL, NULL, 0, 0);
-                }
-            }
-        }
+        rc = on_event(&b, &ev, err, errlen);
         yaml_event_delete(&ev);
-        if (done)
-            break;
     }
-    if (rc != 0) {
+    if (rc < 0) {
         /* free whatever is still open: each open container is owned only by the stack */
-        for (int i = depth - 1; i >= 0; i--) {
-            free(pending_key[i]);
-            murk_ynode_free(stack[i]);
+        for (int i = b.depth - 1; i >= 0; i--) {
+            free(b.pending_key[i]);
+            murk_ynode_free(b.stack[i]);
         }
-        if (depth == 0 && *root) {
-            murk_ynode_free(*root);
-        }
+        if (b.depth == 0)
+            murk_ynode_free(b.root);
         *root = NULL;
+        return -1;
     }
-    return rc;
+    *root = b.root;
+    return 0;
 }
 
 static int load(murk_ydoc *doc, const unsigned char *text, size_t len, const char *name, char *err, size_t errlen)

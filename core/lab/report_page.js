@@ -1,6 +1,6 @@
 /* report_page.js — the comparison page's behaviour (`murk compare --html`, `murk bench`'s report.html).
  *
- * The data (the JSON in #murk-data, written by core/cli/report_html.c): every image as linear half floats
+ * The data (the JSON in #murk-data, written by core/lab/report_html.c): every image as linear half floats
  * (IEEE binary16, little endian, base64, in the element named by its id) times 2^exp, and for the variants
  * their per-pixel error maps (the channel mean of the relative squared error against the reference; for a
  * bench the mean over its seeds).

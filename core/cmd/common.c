@@ -1,8 +1,7 @@
-/* common.c — what the murk command's subcommands share (cli.h): the usage text, quoting untrusted text,
+/* common.c — what the murk command's subcommands share (cmd.h): the usage text, quoting untrusted text,
  * the one-line error and usage messages, the stop signals of render and bench, and whether to show
- * progress. Part of the murk executable; cli.c dispatches to the subcommands, which all reach this file
- * and none reaches cli.c. */
-#include "cli/cli.h"
+ * progress. Reaches no subcommand; a static library, so that each binary holding subcommands links its copy. */
+#include "cmd/cmd.h"
 #include "util/util.h"
 
 #include <signal.h>
@@ -48,7 +47,7 @@ int murk_cli_usage(const char *msg)
     return 2;
 }
 
-/* SIGINT/SIGTERM/SIGHUP during `render` and `bench` (murk_cli_catch_stop_signals, cli.h): the flag is set
+/* SIGINT/SIGTERM/SIGHUP during `render` and `bench` (murk_cli_catch_stop_signals, cmd.h): the flag is set
  * and murk goes on. render abandons the running pass, writes the image of the whole passes done
  * (murk:interrupted says so) and exits with 128 + the signal's number; bench (bench.c) stops after the
  * running render, keeps only whole renders' rows and exits the same way. A signal that was ignored when

@@ -1,10 +1,10 @@
 /* report_html.c — the interactive comparison page (report_html.h): half-float encoding, the size limit and
  * its downsampling, and the writer that fills the page's template (report_page.html with its CSS and
- * JavaScript, built in by tools/embed.c) with the data. Part of the murk executable. */
-#include "cli/report_html.h"
+ * JavaScript, built in by tools/embed.c) with the data. Part of libmurklab. */
+#include "lab/report_html.h"
 
+#include "lab/report_page.h" /* generated: murk_page_html, murk_page_css, murk_page_js */
 #include "util/atomic.h"
-#include "cli/report_page.h" /* generated: murk_page_html, murk_page_css, murk_page_js */
 #include "util/util.h"
 
 #include <math.h>

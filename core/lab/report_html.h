@@ -1,7 +1,7 @@
 /* report_html.h — the interactive comparison page (`murk compare --html`, `murk bench`'s report.html): one
  * self-contained HTML file holding linear images as half floats, which the page's JavaScript shows with an
  * exposure slider, flipping, a split view, zoom, error and efficiency maps (report_page.{html,css,js},
- * built into the executable). Part of the murk executable; needs only libc, libm and murk_write_atomic.
+ * built into libmurklab). Part of libmurklab; needs only libc, libm and murk_write_atomic.
  *
  * Data: every image (3 channels) and error map (1 channel) travels as IEEE 754 binary16, little endian,
  * base64, after division by a power of two 2^e per array (e chosen so that its largest finite |value| is

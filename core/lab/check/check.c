@@ -44,14 +44,14 @@
  *            `delta`) must still give 1, whether the integrator handles media or ignores them.
  *
  * Each check was seen to fail against a broken plugin (docs/plugins.md lists which). */
-#include "check/check.h"
-
-#include "check/sphere.h"
+#include "lab/check/sphere.h"
 #include "media/density.h"
 #include "plugin/plugin_loader.h"
 #include "render/host.h"
 #include "scene/scene.h"
 #include "util/runtime.h"
+#include "util/util.h"
+#include "murk/lab.h"
 #include "murk/murk.h"
 
 #include <errno.h>
@@ -870,7 +870,7 @@ static int check_one(ck *c, const char *arg)
     return c->fails == fails0 ? 0 : 1;
 }
 
-MURK_API int murk_check_main(int argc, char **argv)
+MURK_API int murk_lab_check(int argc, char **argv)
 {
     ck *c = calloc(1, sizeof *c);
     if (!c)
@@ -878,7 +878,7 @@ MURK_API int murk_check_main(int argc, char **argv)
     c->seed = 1;
     const char *plugins[64];
     int np = 0;
-    for (int i = 1; i < argc; i++) {
+    for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) {
             c->quick = 1;
         } else if (!strcmp(argv[i], "--seed") && i + 1 < argc) {

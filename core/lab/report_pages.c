@@ -1,10 +1,10 @@
 /* report_pages.c — the comparison pages of the commands: `murk compare --html` (below) builds its page
  * from the two images; `murk bench` fills one as it renders (bench.c calls report_html.h directly).
- * Part of the murk executable. */
+ * Part of libmurklab. */
+#include "lab/report_html.h"
 #include "util/limit.h"
-#include "cli/metrics.h"
-#include "cli/report_html.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,15 +1,16 @@
-/* metrics.c — the image-against-reference figures of `murk compare` and `murk bench` (metrics.h).
+/* metrics.c — the image-against-reference figures of `murk compare` and `murk bench` (murk/lab.h).
  *
  * relMSE = mean over pixel-channels of (a - r)^2 / (r^2 + 0.01) (the 0.01 keeps black pixels from
  * dominating). With independent renders E[(a - r)^2] = bias^2 + Var a + Var r: the reference's noise
  * adds Var r, which the corrected figure subtracts with an unbiased estimate v of it. The standard
  * errors treat pixels as independent samples — they are: murk draws one random stream per pixel. */
-#include "cli/metrics.h"
+#include "util/util.h"
+#include "murk/lab.h"
 
 #include <math.h>
 
-void murk_metrics_compute(const float *a, const float *r, const float *v, int w, murk_crop c, murk_metrics *m,
-                          float *pix)
+MURK_API void murk_metrics_compute(const float *a, const float *r, const float *v, int w, murk_crop c,
+                                   murk_metrics *m, float *pix)
 {
     *m = (murk_metrics){0};
     double se = 0, sr = 0, sn = 0, sm = 0, t1 = 0, t2 = 0, d1[4] = {0}, d2[4] = {0};

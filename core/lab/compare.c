@@ -4,13 +4,13 @@
  * bias test (mean difference, its standard error and z-score), the efficiency from the render time and
  * cost counters the EXR records, and two pictures of the difference: a heat map of |a - r| scaled to its
  * 99th percentile, and beside it a signed map on a fixed scale; --html, the interactive comparison page
- * (cli/report_html.h). Part of the murk executable. */
-#include "cli/cli.h"
-#include "cli/metrics.h"
-#include "cli/report_html.h"
+ * (lab/report_html.h). Part of libmurklab (murk/lab.h). */
+#include "cmd/cmd.h"
 #include "image/image.h"
+#include "lab/report_html.h"
 #include "util/atomic.h"
 #include "util/util.h"
+#include "murk/lab.h"
 
 #include <errno.h>
 #include <math.h>
@@ -132,121 +132,163 @@ static int write_maps(const char *diff, const float *A, const float *B, int w, m
     return rc;
 }
 
-int murk_cli_compare(int argc, char **argv)
+typedef struct compare_opts {
+    const char *a, *b, *diff, *html; /* TEST, REFERENCE, --diff, --html */
+    int json, cropped;
+    double scale;
+    murk_crop crop;
+} compare_opts;
+
+/* The arguments into o: 0, or the usage status after a message. */
+static int compare_options(compare_opts *o, int argc, char **argv)
 {
-    const char *a = NULL, *b = NULL, *diff = NULL, *html = NULL;
-    int json = 0, cropped = 0;
-    double scale = 1.0;
-    murk_crop crop = {0, 0, 0, 0};
+    *o = (compare_opts){.scale = 1.0};
     for (int i = 0; i < argc; i++) {
         if (!strcmp(argv[i], "--diff")) {
             if (i + 1 >= argc)
                 return usage("--diff needs a .png file name");
-            diff = argv[++i];
+            o->diff = argv[++i];
         } else if (!strcmp(argv[i], "--html")) {
             if (i + 1 >= argc)
                 return usage("--html needs an .html file name");
-            html = argv[++i];
+            o->html = argv[++i];
         } else if (!strcmp(argv[i], "--crop")) {
-            if (i + 1 >= argc || parse_crop(argv[i + 1], &crop))
+            if (i + 1 >= argc || parse_crop(argv[i + 1], &o->crop))
                 return usage("--crop needs X,Y,W,H (whole numbers, W and H above 0)");
-            cropped = 1;
+            o->cropped = 1;
             i++;
         } else if (!strcmp(argv[i], "--scale")) {
             char *end = NULL;
-            scale = i + 1 < argc ? strtod(argv[i + 1], &end) : 0;
-            if (!end || *end || !(scale > 0) || !isfinite(scale))
+            o->scale = i + 1 < argc ? strtod(argv[i + 1], &end) : 0;
+            if (!end || *end || !(o->scale > 0) || !isfinite(o->scale))
                 return usage("--scale needs a positive number (the signed map's full scale)");
             i++;
         } else if (!strcmp(argv[i], "--json")) {
-            json = 1;
+            o->json = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             fprintf(stderr, "murk: unknown compare option '%s'\n", murk_cli_q(argv[i]));
             return usage(NULL);
-        } else if (!a) {
-            a = argv[i];
-        } else if (!b) {
-            b = argv[i];
+        } else if (!o->a) {
+            o->a = argv[i];
+        } else if (!o->b) {
+            o->b = argv[i];
         } else {
             return usage("compare takes two images");
         }
     }
-    if (!a || !b)
-        return usage("compare needs two EXR files: TEST REFERENCE");
+    return !o->a || !o->b ? usage("compare needs two EXR files: TEST REFERENCE") : 0;
+}
+
+/* The figures of TEST against REFERENCE: the metrics, the bias test's z, and the efficiency from TEST's
+ * render time (t) and density lookups (look), each -1 when unknown. */
+typedef struct figures {
+    murk_metrics m;
+    double z, t, look, eff_t, eff_l;
+} figures;
+
+/* The --json object (also the page's figures), malloc'd; NULL when out of memory. */
+static char *figures_json(const compare_opts *o, const figures *f)
+{
+    const murk_metrics *m = &f->m;
+    const murk_crop *c = &o->crop;
+    char *js = NULL;
+    size_t jl = 0;
+    FILE *jf = open_memstream(&js, &jl);
+    if (!jf)
+        return NULL;
+    fprintf(jf, "{\"test\": \"%s\", \"reference\": \"%s\", \"crop\": [%d, %d, %d, %d], \"n\": %zu, "
+           "\"nonfinite\": %zu, \"mse\": %.9g, \"relmse\": %.9g, \"relmse_se\": %.9g, \"mare\": %.9g, "
+           "\"diff\": [%.9g, %.9g, %.9g, %.9g], \"diff_se\": [%.9g, %.9g, %.9g, %.9g], \"z\": %.6g",
+           murk_cli_q(o->a), murk_cli_q(o->b), c->x, c->y, c->w, c->h, m->n, m->nonfinite, m->mse, m->relmse,
+           m->relmse_se, m->mare, m->diff[0], m->diff[1], m->diff[2], m->diff[3], m->diff_se[0], m->diff_se[1],
+           m->diff_se[2], m->diff_se[3], f->z);
+    if (f->t > 0)
+        fprintf(jf, ", \"seconds\": %.6g, \"efficiency_time\": %.9g", f->t, f->eff_t);
+    if (f->look > 0)
+        fprintf(jf, ", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", f->look, f->eff_l);
+    fprintf(jf, "}\n");
+    fclose(jf);
+    return js;
+}
+
+static void print_figures(const compare_opts *o, const figures *f)
+{
+    const murk_metrics *m = &f->m;
+    printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
+           m->mse, m->relmse, m->mare, murk_cli_q(o->a), murk_cli_q(o->b));
+    if (o->cropped)
+        printf("crop: %dx%d pixels at (%d, %d)\n", o->crop.w, o->crop.h, o->crop.x, o->crop.y);
+    printf("relMSE standard error %.2e; difference a-b: mean %.4e ± %.2e (z = %.2f; r %.3e, g %.3e, b %.3e): "
+           "%s\n", m->relmse_se, m->diff[3], m->diff_se[3], f->z, m->diff[0], m->diff[1], m->diff[2],
+           fabs(f->z) < 3 ? "no sign of a different expected image (|z| < 3)"
+                          : "the expected images differ (|z| >= 3: bias, or a reference of another scene)");
+    if (f->t > 0)
+        printf("efficiency 1/(relMSE x seconds) = %.4g (render time %.3g s, murk:render_time)\n", f->eff_t, f->t);
+    if (f->look > 0)
+        printf("efficiency 1/(relMSE x density lookups) = %.4g (%.0f lookups, murk:counters)\n", f->eff_l, f->look);
+}
+
+/* Two images of one size, the crop inside them: the figures (text or --json), then the --diff maps and
+ * the --html page. The exit status. */
+static int compare_images(const compare_opts *o, const murk_image *A, const murk_image *B)
+{
+    figures f;
+    murk_metrics_compute(A->rgb, B->rgb, NULL, A->w, o->crop, &f.m, NULL);
+    f.z = f.m.diff_se[3] > 0 ? f.m.diff[3] / f.m.diff_se[3] : 0.0;
+    f.t = render_seconds(A), f.look = render_lookups(A);
+    f.eff_t = f.t > 0 && f.m.relmse > 0 ? 1.0 / (f.m.relmse * f.t) : -1;
+    f.eff_l = f.look > 0 && f.m.relmse > 0 ? 1.0 / (f.m.relmse * f.look) : -1;
+    char *js = o->json || o->html ? figures_json(o, &f) : NULL, err[1024];
+    int rc = 0;
+    if (o->json)
+        fputs(js ? js : "", stdout);
+    else
+        print_figures(o, &f);
+    if (f.m.nonfinite)
+        fprintf(stderr, "murk: warning: %zu non-finite values skipped\n", f.m.nonfinite);
+    if (o->diff)
+        rc = write_maps(o->diff, A->rgb, B->rgb, A->w, o->crop, o->scale, o->json);
+    if (o->html && rc == 0) {
+        if (!js || murk_html_compare(o->html, o->a, o->b, A->rgb, B->rgb, A->w, &o->crop, js, f.t, f.look, err,
+                                     sizeof err) != 0) {
+            cli_error(js ? err : "out of memory");
+            rc = 1;
+        } else if (!o->json) {
+            printf("comparison page: %s\n", murk_cli_q(o->html));
+        }
+    }
+    free(js);
+    return rc;
+}
+
+MURK_API int murk_lab_compare(int argc, char **argv)
+{
+    compare_opts o;
+    int rc = compare_options(&o, argc, argv);
+    if (rc)
+        return rc;
     murk_image A = {0}, B = {0};
     char err[1024];
-    if (html && murk_html_check_path(html, err, sizeof err) != 0) { /* before any work */
+    if (o.html && murk_html_check_path(o.html, err, sizeof err) != 0) { /* before any work */
         cli_error(err);
         return 1;
     }
-    if (murk_exr_read(a, &A, err, sizeof err) || murk_exr_read(b, &B, err, sizeof err)) {
+    if (murk_exr_read(o.a, &A, err, sizeof err) || murk_exr_read(o.b, &B, err, sizeof err)) {
         cli_error(err);
         murk_image_free(&A);
         return 1;
     }
-    int rc = 0;
-    if (!cropped)
-        crop = (murk_crop){0, 0, A.w, A.h};
+    if (!o.cropped)
+        o.crop = (murk_crop){0, 0, A.w, A.h};
     if (A.w != B.w || A.h != B.h) {
-        fprintf(stderr, "murk: %s is %dx%d but %s is %dx%d\n", murk_cli_q(a), A.w, A.h, murk_cli_q(b), B.w, B.h);
+        fprintf(stderr, "murk: %s is %dx%d but %s is %dx%d\n", murk_cli_q(o.a), A.w, A.h, murk_cli_q(o.b), B.w, B.h);
         rc = 1;
-    } else if ((long)crop.x + crop.w > A.w || (long)crop.y + crop.h > A.h) {
-        fprintf(stderr, "murk: --crop %d,%d,%d,%d reaches outside the %dx%d images\n", crop.x, crop.y, crop.w, crop.h,
-                A.w, A.h);
+    } else if ((long)o.crop.x + o.crop.w > A.w || (long)o.crop.y + o.crop.h > A.h) {
+        fprintf(stderr, "murk: --crop %d,%d,%d,%d reaches outside the %dx%d images\n", o.crop.x, o.crop.y, o.crop.w,
+                o.crop.h, A.w, A.h);
         rc = 2;
     } else {
-        murk_metrics m;
-        murk_metrics_compute(A.rgb, B.rgb, NULL, A.w, crop, &m, NULL);
-        double z = m.diff_se[3] > 0 ? m.diff[3] / m.diff_se[3] : 0.0;
-        double t = render_seconds(&A), look = render_lookups(&A);
-        double eff_t = t > 0 && m.relmse > 0 ? 1.0 / (m.relmse * t) : -1;
-        double eff_l = look > 0 && m.relmse > 0 ? 1.0 / (m.relmse * look) : -1;
-        char *js = NULL; /* the --json object, also the page's figures */
-        size_t jl = 0;
-        FILE *jf = json || html ? open_memstream(&js, &jl) : NULL;
-        if (jf) {
-            fprintf(jf, "{\"test\": \"%s\", \"reference\": \"%s\", \"crop\": [%d, %d, %d, %d], \"n\": %zu, "
-                   "\"nonfinite\": %zu, \"mse\": %.9g, \"relmse\": %.9g, \"relmse_se\": %.9g, \"mare\": %.9g, "
-                   "\"diff\": [%.9g, %.9g, %.9g, %.9g], \"diff_se\": [%.9g, %.9g, %.9g, %.9g], \"z\": %.6g",
-                   murk_cli_q(a), murk_cli_q(b), crop.x, crop.y, crop.w, crop.h, m.n, m.nonfinite, m.mse, m.relmse,
-                   m.relmse_se, m.mare, m.diff[0], m.diff[1], m.diff[2], m.diff[3], m.diff_se[0], m.diff_se[1],
-                   m.diff_se[2], m.diff_se[3], z);
-            if (t > 0)
-                fprintf(jf, ", \"seconds\": %.6g, \"efficiency_time\": %.9g", t, eff_t);
-            if (look > 0)
-                fprintf(jf, ", \"lookups\": %.0f, \"efficiency_lookups\": %.9g", look, eff_l);
-            fprintf(jf, "}\n");
-            fclose(jf);
-        }
-        if (json) {
-            fputs(js ? js : "", stdout);
-        } else {
-            printf("MSE %.6e  relMSE %.6e  mean-abs-rel %.6e  (%s against reference %s; relMSE = mean (a-b)^2/(b^2+0.01))\n",
-                   m.mse, m.relmse, m.mare, murk_cli_q(a), murk_cli_q(b));
-            if (cropped)
-                printf("crop: %dx%d pixels at (%d, %d)\n", crop.w, crop.h, crop.x, crop.y);
-            printf("relMSE standard error %.2e; difference a-b: mean %.4e ± %.2e (z = %.2f; r %.3e, g %.3e, b %.3e): "
-                   "%s\n", m.relmse_se, m.diff[3], m.diff_se[3], z, m.diff[0], m.diff[1], m.diff[2],
-                   fabs(z) < 3 ? "no sign of a different expected image (|z| < 3)"
-                               : "the expected images differ (|z| >= 3: bias, or a reference of another scene)");
-            if (t > 0)
-                printf("efficiency 1/(relMSE x seconds) = %.4g (render time %.3g s, murk:render_time)\n", eff_t, t);
-            if (look > 0)
-                printf("efficiency 1/(relMSE x density lookups) = %.4g (%.0f lookups, murk:counters)\n", eff_l, look);
-        }
-        if (m.nonfinite)
-            fprintf(stderr, "murk: warning: %zu non-finite values skipped\n", m.nonfinite);
-        if (diff)
-            rc = write_maps(diff, A.rgb, B.rgb, A.w, crop, scale, json);
-        if (html && rc == 0) {
-            if (!js || murk_html_compare(html, a, b, A.rgb, B.rgb, A.w, &crop, js, t, look, err, sizeof err) != 0) {
-                cli_error(js ? err : "out of memory");
-                rc = 1;
-            } else if (!json) {
-                printf("comparison page: %s\n", murk_cli_q(html));
-            }
-        }
-        free(js);
+        rc = compare_images(&o, &A, &B);
     }
     murk_image_free(&A);
     murk_image_free(&B);

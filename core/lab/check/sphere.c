@@ -1,6 +1,6 @@
 /* sphere.c — numerical integration over the sphere of directions and Pearson's chi-square test, for
  * `murk check` and the BSDF tests (tests/bsdftest.c wraps these): see sphere.h. */
-#include "check/sphere.h"
+#include "lab/check/sphere.h"
 
 #include <math.h>
 #include <stdlib.h>
