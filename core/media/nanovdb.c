@@ -59,9 +59,9 @@ static uint64_t bswap64(uint64_t v)
     return r;
 }
 
-/* Finds the first float grid; sets *off / *len to its buffer within the file. */
-static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t size, uint64_t *off, uint64_t *len,
-                          char *err, size_t errlen)
+/* The file's magic: 1 for grid buffers back to back (a raw grid), 0 for NanoVDB's segmented file format, or
+ * -1 with err (not NanoVDB, OpenVDB, big-endian, too short). */
+static int nvdb_file_kind(const char *path, const unsigned char *b, uint64_t size, char *err, size_t errlen)
 {
     if (size >= 4 && murk_rd_u32(b) == 0x56444220u) {
         murk_err_file(err, errlen, path, "an OpenVDB .vdb file, not NanoVDB (convert it with nanovdb_convert)");
@@ -80,103 +80,128 @@ static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t siz
         murk_err_file(err, errlen, path, "not a NanoVDB file (bad magic)");
         return -1;
     }
-    int raw = magic == NVDB_MAGIC_GRID ||
-              (magic == NVDB_MAGIC_NUMB && nvdb_major(murk_rd_u32(b + 8)) != NVDB_MAJOR && size >= 20 &&
-               nvdb_major(murk_rd_u32(b + 16)) == NVDB_MAJOR);
-    if (raw) { /* grid buffers back to back */
-        for (uint64_t p = 0; p < size;) {
-            if (size - p < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
-                murk_err_file(err, errlen, path, "truncated grid at byte %llu", (unsigned long long)p);
-                return -1;
-            }
-            uint64_t m = murk_rd_u64(b + p);
-            uint32_t ver = murk_rd_u32(b + p + 16);
-            uint64_t gsize = murk_rd_u64(b + p + 32);
-            if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_GRID) {
-                murk_err_file(err, errlen, path, "bad grid magic at byte %llu", (unsigned long long)p);
-                return -1;
-            }
-            if (nvdb_major(ver) != NVDB_MAJOR) {
-                murk_err_file(err, errlen, path, "NanoVDB grid version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
-                return -1;
-            }
-            if (gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE || gsize > size - p) {
-                murk_err_file(err, errlen, path, "grid at byte %llu claims %llu bytes; %llu remain", (unsigned long long)p, (unsigned long long)gsize, (unsigned long long)(size - p));
-                return -1;
-            }
-            if (murk_rd_u32(b + p + 636) == NVDB_TYPE_FLOAT) {
-                *off = p;
-                *len = gsize;
-                return 0;
-            }
-            p += gsize;
-        }
-        murk_err_file(err, errlen, path, "no float grid in the file");
-        return -1;
-    }
-    for (uint64_t p = 0; p < size;) { /* segments */
-        if (size - p < 16) {
-            murk_err_file(err, errlen, path, "truncated segment header at byte %llu", (unsigned long long)p);
+    return magic == NVDB_MAGIC_GRID || (magic == NVDB_MAGIC_NUMB && nvdb_major(murk_rd_u32(b + 8)) != NVDB_MAJOR &&
+                                        size >= 20 && nvdb_major(murk_rd_u32(b + 16)) == NVDB_MAJOR);
+}
+
+/* Grid buffers back to back: the first float grid's offset and length. */
+static int nvdb_find_raw(const char *path, const unsigned char *b, uint64_t size, uint64_t *off, uint64_t *len,
+                         char *err, size_t errlen)
+{
+    for (uint64_t p = 0; p < size;) {
+        if (size - p < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
+            murk_err_file(err, errlen, path, "truncated grid at byte %llu", (unsigned long long)p);
             return -1;
         }
         uint64_t m = murk_rd_u64(b + p);
-        uint32_t ver = murk_rd_u32(b + p + 8);
-        unsigned count = b[p + 12] | (unsigned)b[p + 13] << 8;
-        unsigned codec = b[p + 14] | (unsigned)b[p + 15] << 8;
-        if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_FILE) {
-            murk_err_file(err, errlen, path, "bad segment magic at byte %llu", (unsigned long long)p);
+        uint32_t ver = murk_rd_u32(b + p + 16);
+        uint64_t gsize = murk_rd_u64(b + p + 32);
+        if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_GRID) {
+            murk_err_file(err, errlen, path, "bad grid magic at byte %llu", (unsigned long long)p);
             return -1;
         }
         if (nvdb_major(ver) != NVDB_MAJOR) {
-            murk_err_file(err, errlen, path, "NanoVDB file version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
+            murk_err_file(err, errlen, path, "NanoVDB grid version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
             return -1;
         }
-        if (codec != 0) {
-            murk_err_file(err, errlen, path, "grids compressed with %s; murk reads uncompressed NanoVDB files only (re-save "
-                   "it without compression)", codec == 1 ? "ZIP" : (codec == 2 ? "BLOSC" : "an unknown codec"));
+        if (gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE || gsize > size - p) {
+            murk_err_file(err, errlen, path, "grid at byte %llu claims %llu bytes; %llu remain", (unsigned long long)p, (unsigned long long)gsize, (unsigned long long)(size - p));
             return -1;
         }
-        /* First pass: find where the grid buffers start (after all metadata and names). */
-        uint64_t q = p + 16;
-        for (unsigned i = 0; i < count; i++) {
-            if (size - q < NVDB_META_SIZE) {
-                murk_err_file(err, errlen, path, "truncated grid metadata at byte %llu", (unsigned long long)q);
-                return -1;
-            }
-            uint64_t name = murk_rd_u32(b + q + 136);
-            if (name > size - q - NVDB_META_SIZE) {
-                murk_err_file(err, errlen, path, "truncated grid name at byte %llu", (unsigned long long)q);
-                return -1;
-            }
-            q += NVDB_META_SIZE + name;
+        if (murk_rd_u32(b + p + 636) == NVDB_TYPE_FLOAT) {
+            *off = p;
+            *len = gsize;
+            return 0;
         }
-        /* Second pass: walk metadata and buffers together. */
-        uint64_t meta = p + 16, data = q;
-        for (unsigned i = 0; i < count; i++) {
-            uint64_t gsize = murk_rd_u64(b + meta), fsize = murk_rd_u64(b + meta + 8);
-            uint32_t type = murk_rd_u32(b + meta + 32);
-            unsigned mcodec = b[meta + 168] | (unsigned)b[meta + 169] << 8;
-            if (mcodec != 0) {
-                murk_err_file(err, errlen, path, "grid %u is compressed; murk reads uncompressed NanoVDB files only", i);
-                return -1;
-            }
-            if (fsize > size - data) {
-                murk_err_file(err, errlen, path, "truncated: grid %u needs %llu bytes at byte %llu, %llu remain", i, (unsigned long long)fsize, (unsigned long long)data, (unsigned long long)(size - data));
-                return -1;
-            }
-            if (type == NVDB_TYPE_FLOAT) {
-                if (gsize != fsize || gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
-                    murk_err_file(err, errlen, path, "grid %u has inconsistent sizes (%llu in memory, %llu on disk)", i, (unsigned long long)gsize, (unsigned long long)fsize);
-                    return -1;
-                }
-                *off = data;
-                *len = gsize;
-                return 0;
-            }
-            data += fsize;
-            meta += NVDB_META_SIZE + murk_rd_u32(b + meta + 136);
+        p += gsize;
+    }
+    murk_err_file(err, errlen, path, "no float grid in the file");
+    return -1;
+}
+
+/* One segment of the file format at byte p: its first float grid's offset and length (1), or where the next
+ * segment starts in *next (0), or -1 with err. */
+static int nvdb_find_in_segment(const char *path, const unsigned char *b, uint64_t size, uint64_t p, uint64_t *off,
+                                uint64_t *len, uint64_t *next, char *err, size_t errlen)
+{
+    if (size - p < 16) {
+        murk_err_file(err, errlen, path, "truncated segment header at byte %llu", (unsigned long long)p);
+        return -1;
+    }
+    uint64_t m = murk_rd_u64(b + p);
+    uint32_t ver = murk_rd_u32(b + p + 8);
+    unsigned count = b[p + 12] | (unsigned)b[p + 13] << 8;
+    unsigned codec = b[p + 14] | (unsigned)b[p + 15] << 8;
+    if (m != NVDB_MAGIC_NUMB && m != NVDB_MAGIC_FILE) {
+        murk_err_file(err, errlen, path, "bad segment magic at byte %llu", (unsigned long long)p);
+        return -1;
+    }
+    if (nvdb_major(ver) != NVDB_MAJOR) {
+        murk_err_file(err, errlen, path, "NanoVDB file version %u.%u.%u; murk reads major version %u", nvdb_major(ver), (ver >> 10) & 2047u, ver & 1023u, NVDB_MAJOR);
+        return -1;
+    }
+    if (codec != 0) {
+        murk_err_file(err, errlen, path, "grids compressed with %s; murk reads uncompressed NanoVDB files only (re-save "
+               "it without compression)", codec == 1 ? "ZIP" : (codec == 2 ? "BLOSC" : "an unknown codec"));
+        return -1;
+    }
+    /* First pass: find where the grid buffers start (after all metadata and names). */
+    uint64_t q = p + 16;
+    for (unsigned i = 0; i < count; i++) {
+        if (size - q < NVDB_META_SIZE) {
+            murk_err_file(err, errlen, path, "truncated grid metadata at byte %llu", (unsigned long long)q);
+            return -1;
         }
-        p = data;
+        uint64_t name = murk_rd_u32(b + q + 136);
+        if (name > size - q - NVDB_META_SIZE) {
+            murk_err_file(err, errlen, path, "truncated grid name at byte %llu", (unsigned long long)q);
+            return -1;
+        }
+        q += NVDB_META_SIZE + name;
+    }
+    /* Second pass: walk metadata and buffers together. */
+    uint64_t meta = p + 16, data = q;
+    for (unsigned i = 0; i < count; i++) {
+        uint64_t gsize = murk_rd_u64(b + meta), fsize = murk_rd_u64(b + meta + 8);
+        uint32_t type = murk_rd_u32(b + meta + 32);
+        unsigned mcodec = b[meta + 168] | (unsigned)b[meta + 169] << 8;
+        if (mcodec != 0) {
+            murk_err_file(err, errlen, path, "grid %u is compressed; murk reads uncompressed NanoVDB files only", i);
+            return -1;
+        }
+        if (fsize > size - data) {
+            murk_err_file(err, errlen, path, "truncated: grid %u needs %llu bytes at byte %llu, %llu remain", i, (unsigned long long)fsize, (unsigned long long)data, (unsigned long long)(size - data));
+            return -1;
+        }
+        if (type == NVDB_TYPE_FLOAT) {
+            if (gsize != fsize || gsize < NVDB_GRID_SIZE + NVDB_TREE_SIZE) {
+                murk_err_file(err, errlen, path, "grid %u has inconsistent sizes (%llu in memory, %llu on disk)", i, (unsigned long long)gsize, (unsigned long long)fsize);
+                return -1;
+            }
+            *off = data;
+            *len = gsize;
+            return 1;
+        }
+        data += fsize;
+        meta += NVDB_META_SIZE + murk_rd_u32(b + meta + 136);
+    }
+    *next = data;
+    return 0;
+}
+
+/* The first float grid of a NanoVDB file (raw grids or the segmented file format): its offset and length. */
+static int nvdb_find_grid(const char *path, const unsigned char *b, uint64_t size, uint64_t *off, uint64_t *len,
+                          char *err, size_t errlen)
+{
+    int raw = nvdb_file_kind(path, b, size, err, errlen);
+    if (raw < 0)
+        return -1;
+    if (raw)
+        return nvdb_find_raw(path, b, size, off, len, err, errlen);
+    for (uint64_t p = 0; p < size;) {
+        int rc = nvdb_find_in_segment(path, b, size, p, off, len, &p, err, errlen);
+        if (rc)
+            return rc > 0 ? 0 : -1;
     }
     murk_err_file(err, errlen, path, "no float grid in the file");
     return -1;
