@@ -18,7 +18,8 @@
  *   ball C R                voxels within R of (C, C, C), 1 - r / R (+ a hash of the voxel / 4096): written
  *                           leaf by leaf (fast for millions of voxels); plus active voxels at (0,0,0) and
  *                           (2C, 2C, 2C) so the box spans 2C + 1 voxels
- *   compress none | zip | blosc     (default none)
+ *   compress none | zip | blosc     (default none; inactive values are always left out, OpenVDB's active-mask
+ *                           compression)
  * Exit status 0, or 1 with a message. */
 #include <openvdb/openvdb.h>
 #include <openvdb/io/File.h>
@@ -180,7 +181,7 @@ int main(int argc, char **argv)
     openvdb::GridPtrVec grids;
     Spec g;
     bool have = false;
-    uint32_t compression = openvdb::io::COMPRESS_NONE;
+    uint32_t compression = openvdb::io::COMPRESS_ACTIVE_MASK;
     std::string line;
     while (std::getline(std::cin, line)) {
         std::istringstream in(line.substr(0, line.find('#')));
@@ -199,8 +200,8 @@ int main(int argc, char **argv)
         if (cmd == "compress") {
             std::string c;
             in >> c;
-            compression = c == "zip" ? openvdb::io::COMPRESS_ZIP : c == "blosc" ? openvdb::io::COMPRESS_BLOSC
-                                                                              : openvdb::io::COMPRESS_NONE;
+            uint32_t zip = openvdb::io::COMPRESS_ZIP, blosc = openvdb::io::COMPRESS_BLOSC;
+            compression = openvdb::io::COMPRESS_ACTIVE_MASK | (c == "zip" ? zip : c == "blosc" ? blosc : 0u);
             continue;
         }
         if (!have)

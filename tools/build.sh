@@ -9,7 +9,7 @@ BUILD=${MURK_BUILD_DIR:-build}
 # the comparison page's test (tests/test_report_page.c) opens report.html in.
 PKGS="gcc meson ninja-build pkg-config cmake libembree-dev libopenexr-dev libyaml-dev libpng-dev
       libcmocka-dev libnanovdb-dev glmark2-data python3 python3-matplotlib python3-numpy clang libclang-rt-14-dev
-      openmpi-bin libopenmpi-dev chromium g++ libopenvdb-dev"
+      openmpi-bin libopenmpi-dev chromium g++ libopenvdb-dev libassimp-dev"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

@@ -142,14 +142,18 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
     for (size_t i = 0; i < s->nmedia; i++)
         info_medium(&s->media[i], murk_ymap_get(media, s->media[i].name));
     const murk_ynode *mats = murk_ymap_get(root, "materials");
-    printf("materials (%zu)\n", s->nmaterials);
+    printf("materials (%zu)\n", s->nmaterials + s->nasset_materials);
     for (size_t i = 0; i < s->nmaterials; i++) {
         printf("  %-14s ", murk_printable(buf, sizeof buf, s->materials[i].name));
         put_block(s->materials[i].plugin, murk_ymap_get(mats, s->materials[i].name), type_only, 1);
         putchar('\n');
     }
+    for (size_t i = 0; i < s->nasset_materials; i++) { /* made from assets' own (material: from_file) */
+        printf("  %-14s ", murk_printable(buf, sizeof buf, s->asset_materials[i]->name));
+        put_block(s->asset_materials[i]->plugin, s->asset_docs[i]->root, type_only, 1);
+        putchar('\n');
+    }
     static const char *const shape_type[] = {"quad", "sphere", "box", "mesh"};
-    const murk_ynode *shapes = murk_ymap_get(root, "shapes");
     printf("shapes (%zu)\n", s->nshapes);
     for (size_t i = 0; i < s->nshapes; i++) {
         const murk_shape *sh = &s->shapes[i];
@@ -158,9 +162,8 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
                medium_name(sh->exterior));
         if (!murk_rgb_is_black(sh->emission))
             put_rgb(", emission", sh->emission);
-        const murk_ynode *file = sh->type == MURK_SHAPE_MESH ? murk_ymap_get(shapes->items[i], "file") : NULL;
-        if (file)
-            printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, file->str), sh->ntris);
+        if (sh->type == MURK_SHAPE_MESH && sh->name) /* a mesh's file, or an asset's file#mesh */
+            printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, sh->name), sh->ntris);
         putchar('\n');
     }
     printf("plugins (%zu)\n", s->reg.nloaded);
@@ -190,16 +193,16 @@ void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
     murk_scene_memory(s, it, n);
     static const char *const kinds[] = {"grid", "mesh", "texture", "embree"};
     static const char *const plural[] = {"grids", "meshes", "textures", "Embree"};
-    uint64_t total[4] = {0}, all = 0;
-    size_t count[4] = {0};
+    uint64_t total[4] = {0}, all = 0, dense = 0;
     char b1[32], b2[32];
     if (detail)
         fprintf(f, "memory (bytes held as allocated; README, Limits)\n");
     for (size_t i = 0; i < n; i++) {
         for (int k = 0; k < 4; k++)
             if (!strcmp(it[i].kind, kinds[k]))
-                total[k] += it[i].bytes, count[k]++;
+                total[k] += it[i].bytes;
         all += it[i].bytes;
+        dense += it[i].dense_bytes;
         if (detail)
             fprintf(f, "  %-8s %-24s %10s  %s\n", it[i].kind, murk_cli_q(it[i].name), bytes_text(b1, sizeof b1, it[i].bytes),
                     murk_cli_q(it[i].detail));
@@ -211,9 +214,11 @@ void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
             fprintf(f, "  peak resident memory of this process (VmHWM) %s\n", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
     } else {
         fprintf(f, "memory:");
-        for (int k = 0; k < 4; k++)
-            fprintf(f, "%s %s %s%s", k ? "," : "", plural[k], bytes_text(b1, sizeof b1, total[k]),
-                    k < 3 ? (count[k] ? "" : "") : "");
+        for (int k = 0; k < 4; k++) {
+            fprintf(f, "%s %s %s", k ? "," : "", plural[k], bytes_text(b1, sizeof b1, total[k]));
+            if (k == 0 && dense) /* sparse grids: what their voxels would take dense */
+                fprintf(f, " (sparse; dense %s)", bytes_text(b2, sizeof b2, dense));
+        }
         if (peak >= 0)
             fprintf(f, "; peak resident %s", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
         fputc('\n', f);

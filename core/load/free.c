@@ -33,6 +33,15 @@ MURK_API void murk_scene_free(murk_scene *s)
         free(s->materials[i].name);
     }
     free(s->materials);
+    for (size_t i = 0; i < s->nasset_materials; i++) {
+        s->asset_materials[i]->m.vt->destroy(s->asset_materials[i]->m.self);
+        free(s->asset_materials[i]->name);
+        free(s->asset_materials[i]);
+        murk_ydoc_free(s->asset_docs[i]);
+        free(s->asset_docs[i]);
+    }
+    free(s->asset_materials);
+    free(s->asset_docs);
     murk_media_free(s);
     for (size_t i = 0; i < s->nshapes; i++)
         murk_shape_free(&s->shapes[i]);

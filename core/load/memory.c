@@ -35,9 +35,12 @@ static void grid_item(const murk_named_medium *nm, murk_mem_item *it)
     size_t cells = (size_t)g->res[0] * (size_t)g->res[1] * (size_t)g->res[2];
     snprintf(it->name, sizeof it->name, "%s", nm->name);
     it->bytes = fi.bytes + 2 * cells * sizeof(float);
-    if (fi.sparse)
-        snprintf(it->detail, sizeof it->detail, "sparse %dx%dx%d, %llu active voxels in %zu bricks; bound grid %zu cells",
-                 res[0], res[1], res[2], (unsigned long long)fi.active, fi.bricks, cells);
+    if (fi.sparse) {
+        it->dense_bytes = (uint64_t)res[0] * (uint64_t)res[1] * (uint64_t)res[2] * sizeof(float);
+        snprintf(it->detail, sizeof it->detail, "sparse %dx%dx%d (dense: %.1f MiB), %llu active voxels in %zu bricks; "
+                 "bound grid %zu cells", res[0], res[1], res[2], (double)it->dense_bytes / 1048576.0,
+                 (unsigned long long)fi.active, fi.bricks, cells);
+    }
     else if (fi.grid)
         snprintf(it->detail, sizeof it->detail, "dense %dx%dx%d; bound grid %zu cells", res[0], res[1], res[2], cells);
     else

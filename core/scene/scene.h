@@ -95,6 +95,11 @@ struct murk_scene {
     /* plugins and their instances */
     murk_named_material *materials;
     size_t nmaterials;
+    /* materials made from an asset's own (shapes: - { type: asset, material: from_file }), each with the
+     * YAML text of its parameters (load/asset.c) */
+    murk_named_material **asset_materials;
+    struct murk_ydoc **asset_docs;
+    size_t nasset_materials;
     murk_named_medium *media;
     size_t nmedia;
     const murk_plugin *integrator_plugin;
