@@ -12,7 +12,8 @@
  *                      twice or outside the box, a box too large) each say what and where.
  *   vdb grids          float, half and double grids, values at voxel centres; the grid name missing (the error
  *                      lists the file's grids), unnamed in a file of two, vec3s / int32 / level set / frustum /
- *                      no active voxels / truncated / random bytes: each a "path: ..." error.
+ *                      no active voxels / truncated / random bytes / a metadata count over the file's size: each
+ *                      a "path: ..." error.
  *   closed form        a constant grid of two active 128^3 tiles with an empty tile between them: every
  *                      unbiased transmittance estimator against exp(-sigma_t c n h) within 4 se (the figure
  *                      resolves a 3 % error), and the field's quadrature against the closed form.
@@ -36,7 +37,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 static char err[4096];
 
@@ -470,6 +470,18 @@ static void test_vdb_grids(void **state)
     fclose(in);
     fclose(out);
     expect_vdb_error(tr, "density", "not a readable OpenVDB file");
+    /* the file's metadata count (byte 57, after the 57-byte header) claiming 2^31 - 1 entries: libopenvdb would
+     * loop on its failed stream that many times (the fuzz harness's hang); the framing check refuses it */
+    const char *claims = tmp_path("claims.vdb");
+    in = fopen(p, "rb"), out = fopen(claims, "wb");
+    assert_true(in && out);
+    n = fread(buf, 1, sizeof buf, in);
+    const unsigned char many[4] = {0xff, 0xff, 0xff, 0x7f};
+    memcpy(buf + 57, many, 4);
+    assert_true(fwrite(buf, 1, n, out) == n);
+    fclose(in);
+    fclose(out);
+    expect_vdb_error(claims, "density", "truncated: the file's metadata (2147483647 entries) at byte 61");
     murk_rng rng;
     murk_rng_seed(&rng, 3, 4, 5);
     for (size_t i = 0; i < sizeof buf; i++)
@@ -799,16 +811,9 @@ static void expect_scene_error(const char *vdb, const char *grid, const char *en
     const char *args[] = {"/usr/bin/env", env ? env : "MURK_NOTHING=1", getenv("MURK_EXE"), "render", scene, "-o", out,
                           NULL};
     int rc = run_argv(&log, args);
-    printf("  %s", log);
-    if (rc != 1)
-        fail_msg("exit %d, expected 1", rc);
     char where[700];
     snprintf(where, sizeof where, "%s:4:", scene);
-    assert_contains(log, where);
-    assert_contains(log, needle);
-    struct stat st;
-    assert_true(stat(out, &st) != 0);
-    free(log);
+    assert_refused(log, rc, where, needle, out);
 }
 
 static void test_vdb_bad_scenes(void **state)

@@ -496,8 +496,34 @@ size_t murk_sparse_bytes(const murk_sparse *s)
            s->capowned * sizeof *s->owned + s->capnodes * sizeof *s->nodes;
 }
 
-/* Max and min over the box voxels [a, b] of a sparse field: a brick wholly inside takes its stored
- * extremes, one cut by the range has its voxels in the range read. */
+/* Max and min over the box voxels [a, b] of one brick, table brick (bx, by, bz): a brick wholly inside
+ * takes its stored extremes, one cut by the range has its voxels in the range read. */
+static void brick_range(const murk_sparse *s, int bx, int by, int bz, const int a[3], const int b[3], float *mx,
+                        float *mn)
+{
+    int v0[3] = {8 * bx - s->off[0], 8 * by - s->off[1], 8 * bz - s->off[2]}, c0[3], c1[3], whole = 1;
+    for (int k = 0; k < 3; k++) {
+        c0[k] = v0[k] > a[k] ? v0[k] : a[k];
+        c1[k] = v0[k] + 7 < b[k] ? v0[k] + 7 : b[k];
+        whole &= c0[k] == v0[k] && c1[k] == v0[k] + 7;
+    }
+    const float *br = murk_sparse_brick(s, c0[0], c0[1], c0[2]);
+    if (whole) {
+        *mx = fmaxf(*mx, br[MURK_BRICK_MAX]);
+        *mn = fminf(*mn, br[MURK_BRICK_MIN]);
+        return;
+    }
+    for (int z = c0[2]; z <= c1[2]; z++)
+        for (int y = c0[1]; y <= c1[1]; y++)
+            for (int x = c0[0]; x <= c1[0]; x++) {
+                float v = br[murk_sparse_slot(s, x, y, z)];
+                *mx = fmaxf(*mx, v);
+                *mn = fminf(*mn, v);
+            }
+}
+
+/* Max and min over the box voxels [a, b] of a sparse field, node by node: a node of the empty region holds
+ * zeros only, so a range over a mostly empty box costs its nodes, not its 2^9-voxel blocks. */
 static void sparse_range(const murk_field *f, const int a[3], const int b[3], float *mx, float *mn)
 {
     const murk_sparse *s = f->sparse;
@@ -506,28 +532,23 @@ static void sparse_range(const murk_field *f, const int a[3], const int b[3], fl
         lo[k] = (a[k] + s->off[k]) >> 3;
         hi[k] = (b[k] + s->off[k]) >> 3;
     }
-    for (int bz = lo[2]; bz <= hi[2]; bz++)
-        for (int by = lo[1]; by <= hi[1]; by++)
-            for (int bx = lo[0]; bx <= hi[0]; bx++) {
-                int v0[3] = {8 * bx - s->off[0], 8 * by - s->off[1], 8 * bz - s->off[2]}, c0[3], c1[3], whole = 1;
-                for (int k = 0; k < 3; k++) {
-                    c0[k] = v0[k] > a[k] ? v0[k] : a[k];
-                    c1[k] = v0[k] + 7 < b[k] ? v0[k] + 7 : b[k];
-                    whole &= c0[k] == v0[k] && c1[k] == v0[k] + 7;
-                }
-                const float *br = murk_sparse_brick(s, c0[0], c0[1], c0[2]);
-                if (whole) {
-                    *mx = fmaxf(*mx, br[MURK_BRICK_MAX]);
-                    *mn = fminf(*mn, br[MURK_BRICK_MIN]);
+    for (int nz = lo[2] >> 4; nz <= hi[2] >> 4; nz++)
+        for (int ny = lo[1] >> 4; ny <= hi[1] >> 4; ny++)
+            for (int nx = lo[0] >> 4; nx <= hi[0] >> 4; nx++) {
+                if (s->top[((size_t)nz * (size_t)s->nt[1] + (size_t)ny) * (size_t)s->nt[0] + (size_t)nx] == s->empty) {
+                    *mx = fmaxf(*mx, 0.0f);
+                    *mn = fminf(*mn, 0.0f);
                     continue;
                 }
-                for (int z = c0[2]; z <= c1[2]; z++)
-                    for (int y = c0[1]; y <= c1[1]; y++)
-                        for (int x = c0[0]; x <= c1[0]; x++) {
-                            float v = br[murk_sparse_slot(s, x, y, z)];
-                            *mx = fmaxf(*mx, v);
-                            *mn = fminf(*mn, v);
-                        }
+                int n0[3] = {nx << 4, ny << 4, nz << 4}, b0[3], b1[3];
+                for (int k = 0; k < 3; k++) {
+                    b0[k] = n0[k] > lo[k] ? n0[k] : lo[k];
+                    b1[k] = n0[k] + 15 < hi[k] ? n0[k] + 15 : hi[k];
+                }
+                for (int bz = b0[2]; bz <= b1[2]; bz++)
+                    for (int by = b0[1]; by <= b1[1]; by++)
+                        for (int bx = b0[0]; bx <= b1[0]; bx++)
+                            brick_range(s, bx, by, bz, a, b, mx, mn);
             }
 }
 

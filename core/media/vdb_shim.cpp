@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -91,6 +92,133 @@ std::string grid_names(openvdb::io::File &file)
     return s.empty() ? "none" : s;
 }
 
+/* ---- a check of the file's framing before libopenvdb reads it ----------------------------------------
+ * libopenvdb trusts the lengths and counts the file states: a metadata count, a string's length or a root
+ * node's tile count that claims more than the file holds makes it allocate by the claim and loop on a failed
+ * stream (a hang the fuzz harness found). So the parts that carry such claims are walked here first, each
+ * against the bytes that remain: the header, the file's metadata, every grid descriptor (its offsets in
+ * order inside the file), each grid's metadata and transform, and a float or double grid's root counts.
+ * What lies inside the nodes (masks, values, compressed blocks) is of fixed size or checked by libopenvdb. */
+class Framing {
+public:
+    explicit Framing(const char *path) : in(path, std::ios::binary)
+    {
+        if (!in)
+            throw Failure{"cannot open it"};
+        in.seekg(0, std::ios::end);
+        size = static_cast<uint64_t>(in.tellg());
+        in.seekg(0);
+    }
+    void check()
+    {
+        if (u64() != 0x56444220u)
+            throw Failure{"not a VDB file (bad magic)"};
+        version = u32();
+        if (version < 222 || version > 300)
+            throw Failure{"OpenVDB file format version " + std::to_string(version) + "; murk reads 222 (OpenVDB 3) and later"};
+        skip(8); /* library version */
+        char offsets = static_cast<char>(u8());
+        skip(36); /* uuid, as text */
+        if (!offsets)
+            throw Failure{"the file has no grid offsets (written as a stream); murk reads files written by io::File"};
+        meta_map("the file's metadata");
+        uint32_t grids = u32();
+        for (uint32_t g = 0; g < grids; g++)
+            descriptor(g);
+    }
+
+private:
+    std::ifstream in;
+    uint64_t size = 0, pos = 0;
+    uint32_t version = 0;
+
+    void need(uint64_t n, const std::string &what)
+    {
+        if (n > size - pos)
+            throw Failure{"truncated: " + what + " at byte " + std::to_string(pos) + " claims " + std::to_string(n) +
+                          " bytes, " + std::to_string(size - pos) + " remain"};
+    }
+    void read(void *p, uint64_t n)
+    {
+        need(n, "a field");
+        in.read(static_cast<char *>(p), static_cast<std::streamsize>(n));
+        pos += n;
+    }
+    uint64_t u64() { uint64_t v; read(&v, 8); return v; }
+    uint32_t u32() { uint32_t v; read(&v, 4); return v; }
+    uint8_t u8() { uint8_t v; read(&v, 1); return v; }
+    void skip(uint64_t n, const std::string &what = "a field")
+    {
+        need(n, what);
+        seek(pos + n);
+    }
+    void seek(uint64_t p)
+    {
+        pos = p;
+        in.seekg(static_cast<std::streamoff>(p));
+    }
+    std::string str(const std::string &what)
+    {
+        uint32_t n = u32();
+        need(n, what);
+        std::string s(n, '\0');
+        read(&s[0], n);
+        return s;
+    }
+    /* A MetaMap: a count, then (name, type name, byte count, value) each. */
+    void meta_map(const std::string &what)
+    {
+        uint32_t n = u32();
+        need(12ull * n, what + " (" + std::to_string(n) + " entries)");
+        for (uint32_t i = 0; i < n; i++) {
+            str(what + ": a name");
+            str(what + ": a type name");
+            skip(u32(), what + ": a value");
+        }
+    }
+    /* A grid descriptor and the head of its grid: metadata, transform, root counts. */
+    void descriptor(uint32_t g)
+    {
+        std::string name = str("a grid's name"), type = str("a grid's type");
+        bool instance = !str("a grid's instance parent").empty(); /* an instance has no topology of its own */
+        uint64_t grid = u64(), block = u64(), end = u64();
+        if (!(pos <= grid && grid <= block && block <= end && end <= size))
+            throw Failure{"grid " + std::to_string(g) + " ('" + name + "') has offsets " + std::to_string(grid) + ", " +
+                          std::to_string(block) + ", " + std::to_string(end) + " outside the file's " +
+                          std::to_string(size) + " bytes"};
+        uint64_t next = end;
+        uint64_t limit = size;
+        size = block; /* the head lies before the grid's buffers */
+        seek(grid);
+        skip(4, "a grid's compression"); /* compression flags */
+        meta_map("grid '" + name + "' metadata");
+        transform(name);
+        int vsize = type.rfind("Tree_float_5_4_3", 0) == 0 ? 4 : type.rfind("Tree_double_5_4_3", 0) == 0 ? 8 : 0;
+        if (vsize && !instance) { /* Tree::readTopology's buffer count, then the root: background, tiles, children */
+            skip(4 + static_cast<uint64_t>(vsize), "a grid's root");
+            uint64_t tiles = u32(), children = u32();
+            need(tiles * (13 + static_cast<uint64_t>(vsize)) + children * 12, "grid '" + name + "' root (" +
+                 std::to_string(tiles) + " tiles, " + std::to_string(children) + " children)");
+        }
+        size = limit;
+        seek(next);
+    }
+    /* Transform::read: a map type name, then the map (its size by type; a frustum is refused later). */
+    void transform(const std::string &name)
+    {
+        std::string map = str("grid '" + name + "' transform");
+        static const std::pair<const char *, uint64_t> sizes[] = {
+            {"AffineMap", 128}, {"UnitaryMap", 128}, {"ScaleMap", 120}, {"UniformScaleMap", 120},
+            {"ScaleTranslateMap", 144}, {"UniformScaleTranslateMap", 144}, {"TranslationMap", 24}};
+        for (const auto &m : sizes)
+            if (map == m.first) {
+                skip(m.second, "grid '" + name + "' " + map);
+                return;
+            }
+        throw Failure{"grid '" + name + "' has a non-linear (" + map.substr(0, 64) + ") transform; murk takes affine maps"};
+    }
+};
+
 /* Tiles first (at every level above the leaves), then the leaves, stolen from the tree and freed one by one. */
 template <typename GridT> void send(GridT &grid, const murk_vdb_sink *sink, char *err, size_t errlen)
 {
@@ -144,6 +272,11 @@ template <typename GridT> void send(GridT &grid, const murk_vdb_sink *sink, char
 void read_grid(const char *path, const char *name, uint64_t max_active, const murk_vdb_sink *sink, murk_vdb_meta *meta,
                char *err, size_t errlen)
 {
+    try {
+        Framing(path).check();
+    } catch (const Failure &f) {
+        throw Failure{"not a readable OpenVDB file: " + f.msg};
+    }
     openvdb::io::File file(path);
     file.open(false); /* no delayed loading */
     std::string gname;
