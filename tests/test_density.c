@@ -909,18 +909,21 @@ static void test_nvdb(void **state)
     }
     if (!f)
         fail_msg("%s", err);
-    /* index box [5,15] x [2,5] x [9,14]; world = trans + scale * (ijk -/+ 1/2) */
+    /* active index box [5,15] x [2,5] x [9,14], grown by one voxel of zeros: [4,16] x [1,6] x [8,15];
+     * world = trans + scale * (ijk -/+ 1/2); held sparse (no dense data) */
     int res[3];
     const float *d;
     murk_field_grid(f, res, &d);
-    assert_int_equal(res[0], 11);
-    assert_int_equal(res[1], 4);
-    assert_int_equal(res[2], 6);
+    assert_null(d);
+    assert_int_equal(res[0], 13);
+    assert_int_equal(res[1], 6);
+    assert_int_equal(res[2], 8);
     murk_vec3 lo, hi;
     murk_field_bounds(f, &lo, &hi, NULL);
-    assert_true(lo.x == (float)(-3.0 + 0.5 * 4.5) && hi.x == (float)(-3.0 + 0.5 * 15.5));
-    assert_true(lo.y == (float)(1.0 + 0.25 * 1.5) && hi.y == (float)(1.0 + 0.25 * 5.5));
-    assert_true(lo.z == (float)(0.5 + 2.0 * 8.5) && hi.z == (float)(0.5 + 2.0 * 14.5));
+    assert_true(lo.x == (float)(-3.0 + 0.5 * 3.5) && hi.x == (float)(-3.0 + 0.5 * 16.5));
+    assert_true(lo.y == (float)(1.0 + 0.25 * 0.5) && hi.y == (float)(1.0 + 0.25 * 6.5));
+    assert_true(lo.z == (float)(0.5 + 2.0 * 7.5) && hi.z == (float)(0.5 + 2.0 * 15.5));
+    assert_true(murk_field_voxel(f, 0, 0, 0) == 0.0f && murk_field_voxel(f, 12, 5, 7) == 0.0f);
     for (int z = 9; z <= 14; z++)
         for (int y = 2; y <= 5; y++)
             for (int x = 5; x <= 15; x++) {
@@ -930,11 +933,11 @@ static void test_nvdb(void **state)
                 float got = murk_field_eval(f, w);
                 if (fabsf(got - want) > 1e-6f)
                     fail_msg("voxel (%d %d %d): %.9g, want %.9g", x, y, z, (double)got, (double)want);
-                assert_true(d[((size_t)(z - 9) * 4 + (y - 2)) * 11 + (x - 5)] == want);
+                assert_true(murk_field_voxel(f, x - 4, y - 1, z - 8) == want);
             }
     murk_field_free(f);
 
-    /* non-zero background fills inactive voxels inside the active box */
+    /* inactive voxels inside the active box are 0 whatever the background (empty space) */
     s.background = 0.125f;
     free(b);
     b = nv_write(&s, &n);
@@ -942,8 +945,7 @@ static void test_nvdb(void **state)
     f = murk_field_nvdb_load(p, err, sizeof err);
     if (!f)
         fail_msg("%s", err);
-    murk_field_grid(f, res, &d);
-    assert_true(d[((size_t)(10 - 9) * 4 + (3 - 2)) * 11 + (7 - 5)] == 0.125f);
+    assert_true(murk_field_voxel(f, 7 - 4, 3 - 1, 10 - 8) == 0.0f);
     murk_field_free(f);
     s.background = 0.0f;
     free(b);
@@ -961,7 +963,7 @@ static void test_nvdb(void **state)
         if (!f)
             fail_msg("%s", err);
         murk_field_grid(f, res, &d);
-        assert_true(res[0] == 11 && res[1] == 4 && res[2] == 6 && d[0] == nv_value(5, 2, 9));
+        assert_true(res[0] == 13 && res[1] == 6 && res[2] == 8 && murk_field_voxel(f, 1, 1, 1) == nv_value(5, 2, 9));
         murk_field_free(f);
     }
     put64(b, 0x324244566f6e614eull); /* "NanoVDB2": the segment magic of NanoVDB >= 32.6 */

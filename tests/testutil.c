@@ -143,6 +143,18 @@ int run_murk_argv(char **out, const char *const *args) { return run_captured(out
 
 int run_murk_split(char **out, char **err, const char *const *args) { return run_captured(out, err, args); }
 
+void assert_refused(char *log, int rc, const char *where, const char *needle, const char *out)
+{
+    printf("  %s", log ? log : "(no output)\n");
+    if (rc != 1)
+        fail_msg("exit %d, expected 1", rc);
+    assert_contains(log, where);
+    assert_contains(log, needle);
+    struct stat st;
+    assert_true(stat(out, &st) != 0);
+    free(log);
+}
+
 /* The same chi-square test as `murk check` (core/lab/check/sphere.c). */
 double chi2_test(const double *observed, const double *expected, int nbins, double min_expected, int *dof_out)
 {

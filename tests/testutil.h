@@ -46,6 +46,9 @@ void run_murk_ok(const char *const *args, const char *const *extra);
 int run_murk_split(char **out, char **err, const char *const *args);
 /* The same for any program: argv[0] is its path (e.g. mpirun's, with murk's among the arguments). */
 int run_argv(char **out, const char *const *argv);
+/* Checks a run that must refuse its input: it printed its log, exited 1, said where ("scene.yaml:...") and
+ * needle, and left no output file out. Frees log. */
+void assert_refused(char *log, int rc, const char *where, const char *needle, const char *out);
 
 /* Fails the test unless the EXRs a and b hold bitwise the same pixels (their attributes may differ). */
 void assert_same_pixels(const char *a, const char *b);

@@ -10,7 +10,7 @@ BUILD=${MURK_BUILD_DIR:-build}
 # python3-pytest: the Python module (python/murk) and its tests; python3-yaml: one of those tests.
 PKGS="gcc meson ninja-build pkg-config cmake libembree-dev libopenexr-dev libyaml-dev libpng-dev
       libcmocka-dev libnanovdb-dev glmark2-data python3 python3-matplotlib python3-numpy python3-pytest python3-yaml clang libclang-rt-14-dev
-      openmpi-bin libopenmpi-dev chromium"
+      openmpi-bin libopenmpi-dev chromium g++ libopenvdb-dev libassimp-dev"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

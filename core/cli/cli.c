@@ -550,6 +550,7 @@ static int render_loaded(render_args *ra, const murk_scene *s, volatile sig_atom
         printf("%s, %s: %dx%d, %d spp, %.2f s, %ssamples/s, %srays/s\n", ra->exr, ra->png, res.width, res.height,
                res.spp, res.seconds, sps, rps);
         murk_counters_print(stdout, s, &res);
+        murk_cli_memory_print(stdout, s, 0);
     }
     murk_warn_summary();
     if (res.nonfinite)

@@ -17,6 +17,11 @@ struct murk_scene *murk_cli_load(const char *path, const char *const *sets, size
 
 int murk_cli_plugins(int argc, char **argv); /* plugins.c */
 
+#include <stdio.h>
+/* What the scene holds in memory (info.c): every grid, mesh, texture and Embree's scene with its bytes when
+ * detail, else one line of totals per kind; then the process's peak resident memory. */
+void murk_cli_memory_print(FILE *f, const struct murk_scene *s, int detail);
+
 /* `murk merge OUT.exr PART...` (merge.c): the parts of a --part I/N render into the whole image. */
 int murk_cli_merge(int argc, char **argv);
 

@@ -95,18 +95,24 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
     float factor;
     murk_density_parts(nm->density, &f, &g, &factor);
     int res[3];
-    const float *data;
-    murk_field_grid(f, res, &data);
+    murk_field_grid(f, res, NULL);
+    murk_field_info fi;
+    murk_field_describe(f, &fi);
+    murk_vec3 lo, hi;
+    murk_field_bounds(f, &lo, &hi, NULL);
     printf("    density        ");
     if (dn)
         put_node(dn, NULL, 0);
     else
         printf("{ constant: 1 } (default)");
-    if (data)
-        printf(": grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g], max %g", res[0], res[1], res[2], g->lo.x,
-               g->lo.y, g->lo.z, g->hi.x, g->hi.y, g->hi.z, murk_field_max(f));
+    if (fi.grid)
+        printf(": %s grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g]%s, max %g", fi.sparse ? "sparse" : "dense",
+               res[0], res[1], res[2], lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+               fi.transformed ? " (a rotated box: its bound grid is in index space)" : "", murk_field_max(f));
     else
         printf(": constant %g, everywhere", murk_field_max(f));
+    if (fi.sparse)
+        printf("\n                   %llu active voxels in %zu bricks of 8^3", (unsigned long long)fi.active, fi.bricks);
     float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s));
     printf("\n    majorant       %dx%dx%d cells, majorant_factor %g; largest majorant %g (extinction %g x density "
            "%g x factor)\n", g->res[0], g->res[1], g->res[2], factor,
@@ -139,14 +145,18 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
     for (size_t i = 0; i < s->nmedia; i++)
         info_medium(&s->media[i], murk_ymap_get(media, s->media[i].name));
     const murk_ynode *mats = murk_ymap_get(root, "materials");
-    printf("materials (%zu)\n", s->nmaterials);
+    printf("materials (%zu)\n", s->nmaterials + s->nasset_materials);
     for (size_t i = 0; i < s->nmaterials; i++) {
         printf("  %-14s ", murk_printable(buf, sizeof buf, s->materials[i].name));
         put_block(s->materials[i].plugin, murk_ymap_get(mats, s->materials[i].name), type_only, 1);
         putchar('\n');
     }
+    for (size_t i = 0; i < s->nasset_materials; i++) { /* made from assets' own (material: from_file) */
+        printf("  %-14s ", murk_printable(buf, sizeof buf, s->asset_materials[i]->name));
+        put_block(s->asset_materials[i]->plugin, s->asset_docs[i]->root, type_only, 1);
+        putchar('\n');
+    }
     static const char *const shape_type[] = {"quad", "sphere", "box", "mesh"};
-    const murk_ynode *shapes = murk_ymap_get(root, "shapes");
     printf("shapes (%zu)\n", s->nshapes);
     for (size_t i = 0; i < s->nshapes; i++) {
         const murk_shape *sh = &s->shapes[i];
@@ -155,9 +165,8 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
                medium_name(sh->exterior));
         if (!murk_rgb_is_black(sh->emission))
             put_rgb(", emission", sh->emission);
-        const murk_ynode *file = sh->type == MURK_SHAPE_MESH ? murk_ymap_get(shapes->items[i], "file") : NULL;
-        if (file)
-            printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, file->str), sh->ntris);
+        if (sh->type == MURK_SHAPE_MESH && sh->name) /* a mesh's file, or an asset's file#mesh */
+            printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, sh->name), sh->ntris);
         putchar('\n');
     }
     printf("plugins (%zu)\n", s->reg.nloaded);
@@ -166,6 +175,58 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
         printf("  %-13s %-16s %s (version %s, ABI %u.%u)\n", murk_kind_name((int)p->desc->kind), p->desc->name,
                murk_printable(buf, sizeof buf, p->path), p->version ? p->version : "none", p->abi.major, p->abi.minor);
     }
+}
+
+/* Bytes in binary units: "512 B", "3.4 KiB", "139.8 MiB". */
+static const char *bytes_text(char *buf, size_t n, uint64_t b)
+{
+    static const char *const unit[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    double v = (double)b;
+    int u = 0;
+    while (v >= 1024.0 && u < 4)
+        v /= 1024.0, u++;
+    snprintf(buf, n, u ? "%.1f %s" : "%.0f %s", v, unit[u]);
+    return buf;
+}
+
+void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
+{
+    size_t n = murk_scene_memory(s, NULL, 0);
+    murk_mem_item *it = murk_xmalloc((n ? n : 1) * sizeof *it);
+    murk_scene_memory(s, it, n);
+    static const char *const kinds[] = {"grid", "mesh", "texture", "embree"};
+    static const char *const plural[] = {"grids", "meshes", "textures", "Embree"};
+    uint64_t total[4] = {0}, all = 0, dense = 0;
+    char b1[32], b2[32];
+    if (detail)
+        fprintf(f, "memory (bytes held as allocated; README, Limits)\n");
+    for (size_t i = 0; i < n; i++) {
+        for (int k = 0; k < 4; k++)
+            if (!strcmp(it[i].kind, kinds[k]))
+                total[k] += it[i].bytes;
+        all += it[i].bytes;
+        dense += it[i].dense_bytes;
+        if (detail)
+            fprintf(f, "  %-8s %-24s %10s  %s\n", it[i].kind, murk_cli_q(it[i].name), bytes_text(b1, sizeof b1, it[i].bytes),
+                    murk_cli_q(it[i].detail));
+    }
+    long peak = murk_peak_rss_kb();
+    if (detail) {
+        fprintf(f, "  %-33s %10s\n", "total", bytes_text(b1, sizeof b1, all));
+        if (peak >= 0)
+            fprintf(f, "  peak resident memory of this process (VmHWM) %s\n", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
+    } else {
+        fprintf(f, "memory:");
+        for (int k = 0; k < 4; k++) {
+            fprintf(f, "%s %s %s", k ? "," : "", plural[k], bytes_text(b1, sizeof b1, total[k]));
+            if (k == 0 && dense) /* sparse grids: what their voxels would take dense */
+                fprintf(f, " (sparse; dense %s)", bytes_text(b2, sizeof b2, dense));
+        }
+        if (peak >= 0)
+            fprintf(f, "; peak resident %s", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));
+        fputc('\n', f);
+    }
+    free(it);
 }
 
 murk_scene *murk_cli_load(const char *path, const char *const *sets, size_t nsets)
@@ -257,6 +318,7 @@ int murk_cli_info(int argc, char **argv)
         return 1;
     }
     info_scene(s, scene_path, sets, nsets);
+    murk_cli_memory_print(stdout, s, 1);
     murk_scene_free(s);
     free(sets);
     return 0;

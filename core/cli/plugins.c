@@ -21,7 +21,7 @@ typedef struct special_key {
 static const special_key density_key = {
     .name = "density",
     .type = "map",
-    .doc = "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { cloud: { ... } }",
+    .doc = "{ constant: V } | { grid: FILE.vol|FILE.nvdb } | { vdb: FILE.vdb, grid: NAME } | { cloud: { ... } }",
 };
 /* after the schema's keys */
 static const special_key tail_keys[] = {

@@ -15,6 +15,7 @@ void murk_shape_free(murk_shape *sh)
     free(sh->nrm);
     free(sh->ng);
     free(sh->idx);
+    free(sh->name);
 }
 
 MURK_API void murk_scene_free(murk_scene *s)
@@ -32,6 +33,15 @@ MURK_API void murk_scene_free(murk_scene *s)
         free(s->materials[i].name);
     }
     free(s->materials);
+    for (size_t i = 0; i < s->nasset_materials; i++) {
+        s->asset_materials[i]->m.vt->destroy(s->asset_materials[i]->m.self);
+        free(s->asset_materials[i]->name);
+        free(s->asset_materials[i]);
+        murk_ydoc_free(s->asset_docs[i]);
+        free(s->asset_docs[i]);
+    }
+    free(s->asset_materials);
+    free(s->asset_docs);
     murk_media_free(s);
     for (size_t i = 0; i < s->nshapes; i++)
         murk_shape_free(&s->shapes[i]);

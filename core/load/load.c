@@ -6,6 +6,7 @@
  * "file:line:col: what is wrong". */
 #include "load/load.h"
 #include "media/media.h"
+#include "media/source.h"
 #include "render/accel.h"
 #include "render/checkpoint.h"
 #include "render/host.h"
@@ -102,7 +103,7 @@ static long find_named(const murk_ynode *n, const char *kind, const char *name, 
     return ERR(n, "undefined %s '%s'", kind, name);
 }
 
-static int lookup_medium(const murk_scene *s, const murk_ynode *n, const murk_medium **out, char *err, size_t errlen)
+int murk_load_lookup_medium(const murk_scene *s, const murk_ynode *n, const murk_medium **out, char *err, size_t errlen)
 {
     const char *name = NULL;
     if (murk_yread_string(n, "a medium reference", &name, err, errlen))
@@ -118,8 +119,8 @@ static int lookup_medium(const murk_scene *s, const murk_ynode *n, const murk_me
     return 0;
 }
 
-static int lookup_material(const murk_scene *s, const murk_ynode *n, const murk_material **out, char *err,
-                           size_t errlen)
+int murk_load_lookup_material(const murk_scene *s, const murk_ynode *n, const murk_material **out, char *err,
+                              size_t errlen)
 {
     const char *name = NULL;
     if (murk_yread_string(n, "material", &name, err, errlen))
@@ -135,17 +136,43 @@ static int lookup_material(const murk_scene *s, const murk_ynode *n, const murk_
     return 0;
 }
 
-static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+/* camera: { from_asset: N, asset_camera: NAME }: the camera of the asset shape N (shapes[N]), taken while
+ * that shape loads (load/asset.c); its frame is set once the shapes are loaded (camera_frame). */
+typedef struct camera_request {
+    long long shape;      /* -1: the camera block's own from/at/up/fov */
+    const char *name;     /* asset_camera, or NULL: the first */
+    const murk_ynode *at; /* the from_asset key, for errors */
+    murk_asset_camera cam;
+} camera_request;
+
+static int camera_frame(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+
+static int load_camera(murk_scene *s, const murk_ynode *n, camera_request *req, char *err, size_t errlen)
 {
-    static const char *const keys[] = {"from", "at", "up", "fov", "medium"};
+    static const char *const keys[] = {"from", "at", "up", "fov", "medium", "from_asset", "asset_camera"};
     s->cam_from = murk_v3(0, 0, 5);
     s->cam_at = murk_v3(0, 0, 0);
     s->cam_up = murk_v3(0, 1, 0);
     s->fov = 40.0f;
+    req->shape = -1;
     if (n) {
         if (murk_yexpect_map(n, "camera", err, errlen) || murk_ycheck_keys(n, "camera", keys, NKEYS(keys), err, errlen))
             return -1;
         const murk_ynode *c;
+        if ((c = murk_ymap_get(n, "from_asset"))) {
+            static const char *const own[] = {"from", "at", "up"};
+            for (size_t i = 0; i < NKEYS(own); i++)
+                if (murk_ymap_get(n, own[i]))
+                    return ERR(murk_ymap_get(n, own[i]), "camera: '%s' and from_asset exclude each other (the asset's "
+                               "camera sets from, at and up; fov overrides its field of view)", own[i]);
+            if (murk_yread_int(c, "camera.from_asset (a shape's index)", 0, 1e9, &req->shape, err, errlen))
+                return -1;
+            req->at = c;
+            if ((c = murk_ymap_get(n, "asset_camera")) && murk_yread_string(c, "camera.asset_camera", &req->name, err, errlen))
+                return -1;
+        } else if ((c = murk_ymap_get(n, "asset_camera"))) {
+            return ERR(c, "camera: asset_camera needs from_asset: N (the asset shape whose camera it names)");
+        }
         if ((c = murk_ymap_get(n, "from")) && murk_yread_vec3(c, "camera.from", &s->cam_from, err, errlen))
             return -1;
         if ((c = murk_ymap_get(n, "at")) && murk_yread_vec3(c, "camera.at", &s->cam_at, err, errlen))
@@ -158,9 +185,15 @@ static int load_camera(murk_scene *s, const murk_ynode *n, char *err, size_t err
                 return -1;
             s->fov = (float)fov;
         }
-        if ((c = murk_ymap_get(n, "medium")) && lookup_medium(s, c, &s->camera_medium, err, errlen))
+        if ((c = murk_ymap_get(n, "medium")) && murk_load_lookup_medium(s, c, &s->camera_medium, err, errlen))
             return -1;
     }
+    return req->shape >= 0 ? 0 : camera_frame(s, n, err, errlen);
+}
+
+/* The camera's frame from from, at, up and fov. */
+static int camera_frame(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+{
     murk_vec3 w = murk_sub(s->cam_at, s->cam_from);
     if (murk_length(w) <= 0.0f)
         return ERR(n, "camera: 'from' and 'at' are the same point");
@@ -267,7 +300,7 @@ static void put_quad(murk_shape *sh, uint32_t q, murk_vec3 c, murk_vec3 u, murk_
     t[3] = b, t[4] = b + 2, t[5] = b + 3;
 }
 
-static int read_transform(const murk_ynode *n, float m[12], char *err, size_t errlen)
+int murk_read_transform(const murk_ynode *n, float m[12], char *err, size_t errlen)
 {
     static const char *const keys[] = {"scale", "rotate", "translate"};
     if (murk_yexpect_map(n, "transform", err, errlen) || murk_ycheck_keys(n, "transform", keys, NKEYS(keys), err, errlen))
@@ -304,7 +337,7 @@ static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *e
         return -1;
     float m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     const murk_ynode *t = murk_ymap_get(n, "transform");
-    if (t && read_transform(t, m, err, errlen))
+    if (t && murk_read_transform(t, m, err, errlen))
         return -1;
     char *path = murk_path_relative_to(s->doc.file, file);
     murk_mesh mesh;
@@ -313,6 +346,7 @@ static int load_mesh(murk_scene *s, murk_shape *sh, const murk_ynode *n, char *e
     free(path);
     if (rc != 0)
         return ERR(f, "mesh: %s", merr);
+    sh->name = murk_strdup(file);
     sh->nverts = mesh.nverts;
     sh->ntris = mesh.ntris;
     sh->pos = mesh.pos;
@@ -354,7 +388,7 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
     static const char *const sphere_keys[] = {"type", "material", "emission", "interior", "exterior", "center", "radius"};
     static const char *const box_keys[] = {"type", "material", "emission", "interior", "exterior", "min", "max"};
     static const char *const mesh_keys[] = {"type", "material", "emission", "interior", "exterior", "file", "transform"};
-    static const char *const types[] = {"quad", "sphere", "box", "mesh"};
+    static const char *const types[] = {"quad", "sphere", "box", "mesh", "asset"};
     if (murk_yexpect_map(n, "a shape", err, errlen))
         return -1;
     const murk_ynode *t = murk_yrequire(n, "type", "shape", err, errlen);
@@ -416,13 +450,13 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
         const char *sug = murk_did_you_mean(type, types, NKEYS(types));
         if (sug)
             return ERR(t, "unknown shape type '%s' (did you mean '%s'?)", type, sug);
-        return ERR(t, "unknown shape type '%s'; expected quad, sphere, box or mesh", type);
+        return ERR(t, "unknown shape type '%s'; expected quad, sphere, box, mesh or asset", type);
     }
-    if ((c = murk_ymap_get(n, "material")) && lookup_material(s, c, &sh->material, err, errlen))
+    if ((c = murk_ymap_get(n, "material")) && murk_load_lookup_material(s, c, &sh->material, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "interior")) && lookup_medium(s, c, &sh->interior, err, errlen))
+    if ((c = murk_ymap_get(n, "interior")) && murk_load_lookup_medium(s, c, &sh->interior, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "exterior")) && lookup_medium(s, c, &sh->exterior, err, errlen))
+    if ((c = murk_ymap_get(n, "exterior")) && murk_load_lookup_medium(s, c, &sh->exterior, err, errlen))
         return -1;
     if ((c = murk_ymap_get(n, "emission"))) {
         double e[3];
@@ -438,15 +472,27 @@ static int load_shape(murk_scene *s, const murk_ynode *n, murk_shape *sh, char *
 }
 
 
-static int load_shapes(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
+static int load_shapes(murk_scene *s, const murk_host *host, const murk_ynode *n, camera_request *req, char *err,
+                       size_t errlen)
 {
     if (!n)
         return 0;
     if (n->kind != MURK_Y_SEQ)
         return ERR(n, "shapes must be a list");
-    s->shapes = murk_xmalloc((n->n ? n->n : 1) * sizeof *s->shapes);
+    size_t cap = n->n ? n->n : 1; /* an asset adds a shape per mesh: the array grows */
+    s->shapes = murk_xmalloc(cap * sizeof *s->shapes);
     for (size_t i = 0; i < n->n; i++) {
-        murk_shape *sh = &s->shapes[i];
+        const murk_ynode *t = murk_ymap_get(n->items[i], "type");
+        if (t && t->kind == MURK_Y_SCALAR && !strcmp(t->str, "asset")) {
+            int mine = req->shape == (long long)i;
+            if (murk_load_asset(s, host, n->items[i], &cap, mine ? req->name : NULL, mine ? &req->cam : NULL, err, errlen))
+                return -1;
+            continue;
+        }
+        if (s->nshapes == cap)
+            s->shapes = murk_xrealloc(s->shapes, (cap *= 2) * sizeof *s->shapes);
+        murk_shape *sh = &s->shapes[s->nshapes];
+        memset(sh, 0, sizeof *sh);
         sh->light_base = -1;
         if (load_shape(s, n->items[i], sh, err, errlen)) {
             murk_shape_free(sh);
@@ -456,6 +502,23 @@ static int load_shapes(murk_scene *s, const murk_ynode *n, char *err, size_t err
         s->nshapes++;
     }
     return 0;
+}
+
+/* camera: { from_asset: N }: the asset's camera, once its shape has loaded. */
+static int finish_camera(murk_scene *s, const murk_ynode *camera, camera_request *req, char *err, size_t errlen)
+{
+    if (req->shape < 0)
+        return 0;
+    const murk_ynode *shapes = murk_ymap_get(s->doc.root, "shapes"), *t;
+    if (!shapes || shapes->kind != MURK_Y_SEQ || req->shape >= (long long)shapes->n ||
+        !(t = murk_ymap_get(shapes->items[req->shape], "type")) || t->kind != MURK_Y_SCALAR || strcmp(t->str, "asset"))
+        return ERR(req->at, "camera.from_asset: shapes[%lld] is not an asset shape", req->shape);
+    s->cam_from = req->cam.from;
+    s->cam_at = req->cam.at;
+    s->cam_up = req->cam.up;
+    if (!murk_ymap_get(camera, "fov"))
+        s->fov = req->cam.fov;
+    return camera_frame(s, req->at, err, errlen);
 }
 
 static murk_vec3 vmin3(murk_vec3 a, murk_vec3 b) { return murk_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
@@ -568,7 +631,9 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         if (murk_media_load(s, host, c, err, errlen))
             return -1;
     }
-    if (load_camera(s, murk_ymap_get(root, "camera"), err, errlen))
+    camera_request req;
+    memset(&req, 0, sizeof req);
+    if (load_camera(s, murk_ymap_get(root, "camera"), &req, err, errlen))
         return -1;
     if (load_materials(s, host, murk_ymap_get(root, "materials"), err, errlen))
         return -1;
@@ -578,7 +643,8 @@ static int load_document(murk_scene *s, char *err, size_t errlen)
         return -1;
     /* an integrator built before the lights' ABI gets only emissive shapes to sample (render/lights.h) */
     s->legacy_lights = s->integrator_plugin->abi.minor < MURK_ABI_MINOR_LIGHTS;
-    if (load_shapes(s, murk_ymap_get(root, "shapes"), err, errlen) ||
+    if (load_shapes(s, host, murk_ymap_get(root, "shapes"), &req, err, errlen) ||
+        finish_camera(s, murk_ymap_get(root, "camera"), &req, err, errlen) ||
         murk_load_lights(s, murk_ymap_get(root, "lights"), err, errlen))
         return -1;
     murk_vec3 lo, hi;
@@ -623,12 +689,13 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
         return 0;
     const murk_ynode *root = s->doc.root, *shapes = murk_ymap_get(root, "shapes"), *media = murk_ymap_get(root, "media");
     for (size_t i = 0; shapes && shapes->kind == MURK_Y_SEQ && i < shapes->n; i++) /* meshes */
-        if (names(shapes->items[i], "type", "mesh") && hash_input(s, murk_ymap_get(shapes->items[i], "file"), &h, err, errlen))
+        if ((names(shapes->items[i], "type", "mesh") || names(shapes->items[i], "type", "asset")) &&
+            hash_input(s, murk_ymap_get(shapes->items[i], "file"), &h, err, errlen))
             return 0;
     static const char *const grids[] = {"density", "albedo", "emission", "temperature"};
     for (size_t i = 0; media && i < media->n; i++) /* density, albedo, emission and temperature grids */
         for (size_t g = 0; g < NKEYS(grids); g++)
-            if (hash_input(s, murk_ymap_get(murk_ymap_get(media->items[i], grids[g]), "grid"), &h, err, errlen))
+            if (hash_input(s, murk_field_node_file(murk_ymap_get(media->items[i], grids[g])), &h, err, errlen))
                 return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;

@@ -24,6 +24,8 @@ murk_field *murk_field_constant(float value)
     f->res[0] = f->res[1] = f->res[2] = 1;
     f->lo = murk_v3(-INFINITY, -INFINITY, -INFINITY);
     f->hi = murk_v3(INFINITY, INFINITY, INFINITY);
+    f->wlo = f->lo;
+    f->whi = f->hi;
     return f;
 }
 
@@ -48,8 +50,8 @@ murk_field *murk_field_wrap(const int res[3], murk_vec3 lo, murk_vec3 hi, float 
         return NULL;
     }
     f->kind = FIELD_GRID;
-    f->lo = lo;
-    f->hi = hi;
+    f->lo = f->wlo = lo;
+    f->hi = f->whi = hi;
     f->data = data;
     for (int a = 0; a < 3; a++) {
         f->res[a] = res[a];
@@ -122,10 +124,63 @@ MURK_API murk_field *murk_field_from_voxels(const int res[3], murk_vec3 lo, murk
 
 /* ---- Queries -------------------------------------------------------------------------------- */
 
+/* Trilinear interpolation of the 8 values around a point, v[(z * 2 + y) * 2 + x] for the corner
+ * (x, y, z) in {0, 1}^3, with weights w: the one formula of every grid kind, so that a sparse grid gives
+ * the dense grid's values bit for bit. */
+static inline float trilinear(const float v[8], const float w[3])
+{
+    float c00 = v[0] + w[0] * (v[1] - v[0]);
+    float c10 = v[2] + w[0] * (v[3] - v[2]);
+    float c01 = v[4] + w[0] * (v[5] - v[4]);
+    float c11 = v[6] + w[0] * (v[7] - v[6]);
+    float c0 = c00 + w[1] * (c10 - c00), c1 = c01 + w[1] * (c11 - c01);
+    float r = c0 + w[2] * (c1 - c0);
+    return r > 0.0f ? r : 0.0f; /* rounding cannot make a density of non-negative voxels negative */
+}
+
+/* The 8 values around box voxel i0 of a sparse grid (d: 0 or 1 per axis, the step to the far corner).
+ * When the 2 x 2 x 2 block lies in one brick (7 times in 8 per axis) one brick lookup serves all; otherwise
+ * only the distinct bricks it touches (2, 4 or 8) are looked up. */
+static inline void sparse_corners(const murk_sparse *s, const int i0[3], const int d[3], float v[8])
+{
+    int x = i0[0] + s->off[0], y = i0[1] + s->off[1], z = i0[2] + s->off[2];
+    int cx = (x & 7) + d[0] > 7, cy = (y & 7) + d[1] > 7, cz = (z & 7) + d[2] > 7;
+    const float *b0 = murk_sparse_brick(s, i0[0], i0[1], i0[2]);
+    int o = murk_sparse_slot(s, i0[0], i0[1], i0[2]);
+    if (!(cx | cy | cz)) {
+        int sx = d[0] << 6, sy = d[1] << 3, sz = d[2];
+        v[0] = b0[o];
+        v[1] = b0[o + sx];
+        v[2] = b0[o + sy];
+        v[3] = b0[o + sx + sy];
+        v[4] = b0[o + sz];
+        v[5] = b0[o + sx + sz];
+        v[6] = b0[o + sy + sz];
+        v[7] = b0[o + sx + sy + sz];
+        return;
+    }
+    const float *b[8];
+    b[0] = b0;
+    b[1] = cx ? murk_sparse_brick(s, i0[0] + 1, i0[1], i0[2]) : b0;
+    b[2] = cy ? murk_sparse_brick(s, i0[0], i0[1] + 1, i0[2]) : b0;
+    b[3] = cy ? (cx ? murk_sparse_brick(s, i0[0] + 1, i0[1] + 1, i0[2]) : b[2]) : b[1];
+    for (int k = 4; k < 8; k++) /* the far z layer: the same bricks, or the next brick along z */
+        b[k] = cz ? murk_sparse_brick(s, i0[0] + (k & 1) * d[0], i0[1] + ((k >> 1) & 1) * d[1], i0[2] + 1) : b[k - 4];
+    for (int k = 0; k < 8; k++) {
+        int px = (x + (k & 1) * d[0]) & 7, py = (y + ((k >> 1) & 1) * d[1]) & 7, pz = (z + (k >> 2) * d[2]) & 7;
+        v[k] = b[k][px << 6 | py << 3 | pz];
+    }
+}
+
 float murk_field_eval(const murk_field *f, murk_vec3 p)
 {
     if (f->kind == FIELD_CONSTANT)
         return f->value;
+    if (f->affine) { /* to the grid's local space (field_impl.h) */
+        const float *m = f->w2l;
+        p = murk_v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                    m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+    }
     if (!(p.x >= f->lo.x && p.x <= f->hi.x && p.y >= f->lo.y && p.y <= f->hi.y && p.z >= f->lo.z && p.z <= f->hi.z))
         return 0.0f;
     int i0[3], i1[3];
@@ -144,25 +199,42 @@ float murk_field_eval(const murk_field *f, murk_vec3 p)
         i1[a] = n >= 2 ? i + 1 : i;
         w[a] = u - (float)i;
     }
+    float v[8];
+    if (f->kind == FIELD_SPARSE) {
+        int d[3] = {i1[0] - i0[0], i1[1] - i0[1], i1[2] - i0[2]};
+        sparse_corners(f->sparse, i0, d, v);
+        return trilinear(v, w);
+    }
     const float *d = f->data;
     size_t sx = 1, sy = (size_t)f->res[0], sz = (size_t)f->res[0] * (size_t)f->res[1];
     size_t z0 = (size_t)i0[2] * sz, z1 = (size_t)i1[2] * sz, y0 = (size_t)i0[1] * sy, y1 = (size_t)i1[1] * sy;
     size_t x0 = (size_t)i0[0] * sx, x1 = (size_t)i1[0] * sx;
-    float c00 = d[z0 + y0 + x0] + w[0] * (d[z0 + y0 + x1] - d[z0 + y0 + x0]);
-    float c10 = d[z0 + y1 + x0] + w[0] * (d[z0 + y1 + x1] - d[z0 + y1 + x0]);
-    float c01 = d[z1 + y0 + x0] + w[0] * (d[z1 + y0 + x1] - d[z1 + y0 + x0]);
-    float c11 = d[z1 + y1 + x0] + w[0] * (d[z1 + y1 + x1] - d[z1 + y1 + x0]);
-    float c0 = c00 + w[1] * (c10 - c00), c1 = c01 + w[1] * (c11 - c01);
-    float v = c0 + w[2] * (c1 - c0);
-    return v > 0.0f ? v : 0.0f; /* rounding cannot make a density of non-negative voxels negative */
+    v[0] = d[z0 + y0 + x0];
+    v[1] = d[z0 + y0 + x1];
+    v[2] = d[z0 + y1 + x0];
+    v[3] = d[z0 + y1 + x1];
+    v[4] = d[z1 + y0 + x0];
+    v[5] = d[z1 + y0 + x1];
+    v[6] = d[z1 + y1 + x0];
+    v[7] = d[z1 + y1 + x1];
+    return trilinear(v, w);
 }
 
-void murk_field_bounds(const murk_field *f, murk_vec3 *lo, murk_vec3 *hi, int *infinite)
+MURK_API float murk_field_voxel(const murk_field *f, int x, int y, int z)
+{
+    if (f->kind == FIELD_SPARSE)
+        return murk_sparse_brick(f->sparse, x, y, z)[murk_sparse_slot(f->sparse, x, y, z)];
+    if (f->kind == FIELD_CONSTANT)
+        return f->value;
+    return f->data[((size_t)z * (size_t)f->res[1] + (size_t)y) * (size_t)f->res[0] + (size_t)x];
+}
+
+MURK_API void murk_field_bounds(const murk_field *f, murk_vec3 *lo, murk_vec3 *hi, int *infinite)
 {
     if (lo)
-        *lo = f->lo;
+        *lo = f->wlo;
     if (hi)
-        *hi = f->hi;
+        *hi = f->whi;
     if (infinite)
         *infinite = f->kind == FIELD_CONSTANT;
 }
@@ -178,10 +250,43 @@ MURK_API void murk_field_grid(const murk_field *f, int res[3], const float **dat
         *data = f->data;
 }
 
+MURK_API void murk_field_describe(const murk_field *f, murk_field_info *info)
+{
+    memset(info, 0, sizeof *info);
+    info->grid = f->kind != FIELD_CONSTANT;
+    info->sparse = f->kind == FIELD_SPARSE;
+    info->transformed = f->affine;
+    info->bytes = sizeof *f;
+    if (f->kind == FIELD_GRID)
+        info->bytes += (size_t)f->res[0] * (size_t)f->res[1] * (size_t)f->res[2] * sizeof *f->data;
+    if (f->kind == FIELD_SPARSE) {
+        info->active = f->sparse->active;
+        info->bricks = f->sparse->nowned - 1; /* not the brick of zeros */
+        info->bytes += murk_sparse_bytes(f->sparse);
+    }
+}
+
+murk_ray murk_field_local_ray(const murk_field *f, const murk_ray *r)
+{
+    if (!f->affine)
+        return *r;
+    const float *m = f->w2l;
+    murk_ray l = *r;
+    double o[3] = {r->o.x, r->o.y, r->o.z}, d[3] = {r->d.x, r->d.y, r->d.z}, lo[3], ld[3];
+    for (int a = 0; a < 3; a++) {
+        lo[a] = (double)m[4 * a] * o[0] + (double)m[4 * a + 1] * o[1] + (double)m[4 * a + 2] * o[2] + m[4 * a + 3];
+        ld[a] = (double)m[4 * a] * d[0] + (double)m[4 * a + 1] * d[1] + (double)m[4 * a + 2] * d[2];
+    }
+    l.o = murk_v3((float)lo[0], (float)lo[1], (float)lo[2]);
+    l.d = murk_v3((float)ld[0], (float)ld[1], (float)ld[2]);
+    return l;
+}
+
 MURK_API void murk_field_free(murk_field *f)
 {
     if (!f)
         return;
     free(f->data);
+    murk_sparse_free(f->sparse);
     free(f);
 }

@@ -1,5 +1,7 @@
 /* majorant.c — the bound grid over a density field: per cell a majorant and a minorant of the field
- * (see density.h for the guarantee). Trackers walk it with the DDA in dda.c. */
+ * (see density.h for the guarantee). Trackers walk it with the DDA in dda.c. A grid whose map is not
+ * axis-aligned (field_impl.h, `affine`) gets its bound grid over its local box; the walk transforms
+ * the ray (media.c). */
 #include "media/field_impl.h"
 
 #include <math.h>
@@ -73,22 +75,13 @@ int murk_bound_grid_build(const murk_field *f, int target_res, murk_bound_grid *
             range[a][2 * c + 1] = (int)ceil(ub);
         }
     }
-    size_t sy = (size_t)f->res[0], sz = (size_t)f->res[0] * (size_t)f->res[1];
     size_t k = 0;
     for (int cz = 0; cz < g->res[2]; cz++)
         for (int cy = 0; cy < g->res[1]; cy++)
             for (int cx = 0; cx < g->res[0]; cx++, k++) {
-                float mx = 0.0f, mn = INFINITY;
-                for (int z = range[2][2 * cz]; z <= range[2][2 * cz + 1]; z++)
-                    for (int y = range[1][2 * cy]; y <= range[1][2 * cy + 1]; y++) {
-                        const float *row = f->data + (size_t)z * sz + (size_t)y * sy;
-                        for (int x = range[0][2 * cx]; x <= range[0][2 * cx + 1]; x++) {
-                            mx = fmaxf(mx, row[x]);
-                            mn = fminf(mn, row[x]);
-                        }
-                    }
-                g->maj[k] = mx;
-                g->min[k] = mn;
+                int a[3] = {range[0][2 * cx], range[1][2 * cy], range[2][2 * cz]};
+                int b[3] = {range[0][2 * cx + 1], range[1][2 * cy + 1], range[2][2 * cz + 1]};
+                murk_field_range(f, a, b, &g->maj[k], &g->min[k]);
             }
     for (int a = 0; a < 3; a++)
         free(range[a]);

@@ -21,6 +21,7 @@
 #include "media/media.h"
 #include "media/density.h"
 #include "media/fields.h"
+#include "media/source.h"
 #include "scene/params.h"
 #include "scene/scene.h"
 #include "util/limit.h"
@@ -39,8 +40,9 @@ struct murk_density {
     murk_field *field;
     murk_bound_grid grid;
     float factor;
-    unsigned slot; /* its medium's cost counters (runtime.h) */
-    murk_phase phase;         /* the `phase:` plugin; vt NULL: Henyey-Greenstein of the medium's g */
+    unsigned slot;             /* its medium's cost counters (runtime.h) */
+    int transformed;           /* the field's map rotates, shears or mirrors (murk_field_local_ray) */
+    murk_phase phase;          /* the `phase:` plugin; vt NULL: Henyey-Greenstein of the medium's g */
     murk_medium_fields fields; /* albedo, emission, temperature (fields.h) */
 };
 
@@ -73,7 +75,12 @@ murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w)
 {
     walk *k = (walk *)(void *)w;
-    murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
+    if (d->transformed) { /* the bound grid is in the grid's index space: walk the ray mapped there */
+        murk_ray l = murk_field_local_ray(d->field, ray);
+        murk_dda_init(&k->dda, &d->grid, &l, t0, t1);
+    } else {
+        murk_dda_init(&k->dda, &d->grid, ray, t0, t1);
+    }
     k->factor = d->factor;
     k->count = &murk_thread_counters()[d->slot];
 }
@@ -131,79 +138,10 @@ murk_rgb murk_media_emission(const murk_density *d, murk_vec3 p)
 
 /* ---- scene loading ------------------------------------------------------------------------- */
 
-static murk_field *load_cloud(const murk_ynode *c, char *err, size_t errlen)
-{
-    static const char *const keys[] = {"min", "max", "seed", "frequency", "octaves", "coverage", "resolution"};
-    if (c->kind != MURK_Y_MAP) {
-        murk_yerr(err, errlen, c, "cloud must be a map { min, max, seed, frequency, octaves, coverage, resolution }");
-        return NULL;
-    }
-    if (murk_ycheck_keys(c, "cloud", keys, 7, err, errlen))
-        return NULL;
-    murk_vec3 lo = murk_v3(-0.5f, -0.5f, -0.5f), hi = murk_v3(0.5f, 0.5f, 0.5f);
-    double freq = 3, cov = 0.5;
-    long long seed = 1, oct = 5, res = 64; /* whole numbers: 2.5 is an error, never silently 2 */
-    const murk_ynode *k;
-    if (((k = murk_ymap_get(c, "min")) && murk_yread_vec3(k, "cloud.min", &lo, err, errlen)) ||
-        ((k = murk_ymap_get(c, "max")) && murk_yread_vec3(k, "cloud.max", &hi, err, errlen)) ||
-        ((k = murk_ymap_get(c, "seed")) && murk_yread_int(k, "cloud.seed", 0, 4294967295.0, &seed, err, errlen)) ||
-        ((k = murk_ymap_get(c, "frequency")) && murk_yread_range(k, "cloud.frequency", 0.01, 1000, &freq, err, errlen)) ||
-        ((k = murk_ymap_get(c, "octaves")) && murk_yread_int(k, "cloud.octaves", 1, 16, &oct, err, errlen)) ||
-        ((k = murk_ymap_get(c, "coverage")) && murk_yread_range(k, "cloud.coverage", 0, 1, &cov, err, errlen)) ||
-        ((k = murk_ymap_get(c, "resolution")) && murk_yread_int(k, "cloud.resolution", 2, 1024, &res, err, errlen)))
-        return NULL;
-    if ((double)res * (double)res * (double)res > (double)MURK_FIELD_MAX_VOXELS) {
-        murk_yerr(err, errlen, murk_ymap_get(c, "resolution"), "cloud.resolution %lld gives %.0f voxels, beyond the "
-                  "limit of %llu (%s)", res, (double)res * (double)res * (double)res,
-                  (unsigned long long)MURK_FIELD_MAX_VOXELS, murk_limit_name(MURK_LIMIT_GRID_VOXELS));
-        return NULL;
-    }
-    if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) {
-        murk_yerr(err, errlen, c, "cloud: max must exceed min on every axis");
-        return NULL;
-    }
-    murk_field *f = murk_field_cloud(lo, hi, (int)res, (uint64_t)seed, (float)freq, (int)oct, (float)cov);
-    if (!f)
-        murk_yerr(err, errlen, c, "cloud: could not build the field (out of memory?)");
-    return f;
-}
-
 murk_field *murk_media_scalar_field(const murk_scene *s, const murk_ynode *d, const char *what, char *err,
                                     size_t errlen)
 {
-    static const char *const keys[] = {"constant", "grid", "cloud"};
-    if (d->kind != MURK_Y_MAP || d->n != 1) {
-        murk_yerr(err, errlen, d, "%s must be one of { constant: V }, { grid: FILE.vol|FILE.nvdb }, { cloud: {...} }",
-                  what);
-        return NULL;
-    }
-    if (murk_ycheck_keys(d, what, keys, 3, err, errlen))
-        return NULL;
-    const murk_ynode *k;
-    char label[96];
-    if ((k = murk_ymap_get(d, "constant"))) {
-        double v;
-        snprintf(label, sizeof label, "%s.constant", what);
-        if (murk_yread_range(k, label, 0, 1e30, &v, err, errlen))
-            return NULL;
-        return murk_field_constant((float)v);
-    }
-    if ((k = murk_ymap_get(d, "grid"))) {
-        if (k->kind != MURK_Y_SCALAR || !*k->str) {
-            murk_yerr(err, errlen, k, "%s.grid must be a file name", what);
-            return NULL;
-        }
-        char *path = murk_path_relative_to(s->doc.file, k->str);
-        char ferr[768];
-        size_t l = strlen(path);
-        murk_field *f = (l > 5 && strcmp(path + l - 5, ".nvdb") == 0) ? murk_field_nvdb_load(path, ferr, sizeof ferr)
-                                                                        : murk_field_vol_load(path, ferr, sizeof ferr);
-        free(path);
-        if (!f)
-            murk_yerr(err, errlen, k, "%s grid: %s", what, ferr);
-        return f;
-    }
-    return load_cloud(murk_ymap_get(d, "cloud"), err, errlen);
+    return murk_field_from_node(s->doc.file, d, what, err, errlen);
 }
 
 /* The keys every medium has, whatever its tracker: read by the core with the same schema reader as a
@@ -370,6 +308,9 @@ static int load_medium(murk_scene *s, const murk_host *host, const char *name, c
     nm->density->field = dn ? murk_media_scalar_field(s, dn, "density", err, errlen) : murk_field_constant(1.0f);
     if (!nm->density->field)
         return -1;
+    murk_field_info fi;
+    murk_field_describe(nm->density->field, &fi);
+    nm->density->transformed = fi.transformed;
     if (murk_bound_grid_build(nm->density->field, (int)core[K_MAJORANT_RESOLUTION].f[0], &nm->density->grid) != 0)
         return murk_yerr(err, errlen, dn ? dn : m, "%s: cannot build the majorant grid (out of memory)", who);
     /* The deterministic majorant repair (docs/stability.md). Each bound-grid cell holds the exact maximum of

@@ -25,7 +25,7 @@ int murk_media_check_depth(const murk_scene *s, const murk_ynode *media_node, mu
 extern const murk_param murk_medium_core_params[MURK_MEDIUM_NCORE];
 extern const char *const murk_medium_special_keys[MURK_MEDIUM_NSPECIAL];
 struct murk_field;
-/* A scalar field from a scene node { constant: V } | { grid: F.vol|F.nvdb } | { cloud: {...} }; what names it
+/* A scalar field from a scene node (media/source.h: constant, grid, vdb, cloud); what names it
  * in messages ("density", "temperature"). NULL with a located error. */
 struct murk_field *murk_media_scalar_field(const murk_scene *s, const murk_ynode *d, const char *what, char *err,
                                            size_t errlen);

@@ -201,10 +201,14 @@ static int vol_fill(FILE *fp, const char *tmp, void *user, char *err, size_t err
     int ok = fwrite(h, 1, sizeof h, fp) == sizeof h;
     size_t n = (size_t)f->res[0] * (size_t)f->res[1] * (size_t)f->res[2];
     unsigned char buf[4096];
+    int x = 0, y = 0, z = 0; /* voxel i of a sparse grid */
     for (size_t i = 0; ok && i < n;) {
         size_t k = 0;
-        for (; k < sizeof buf / 4 && i < n; k++, i++)
-            wr_f32(buf + 4 * k, f->data[i]);
+        for (; k < sizeof buf / 4 && i < n; k++, i++) {
+            wr_f32(buf + 4 * k, f->data ? f->data[i] : murk_field_voxel(f, x, y, z));
+            if (++x == f->res[0] && (x = 0, ++y == f->res[1]))
+                y = 0, z++;
+        }
         ok = fwrite(buf, 4, k, fp) == k;
     }
     if (!ok)
@@ -214,8 +218,14 @@ static int vol_fill(FILE *fp, const char *tmp, void *user, char *err, size_t err
 
 MURK_API int murk_field_vol_save(const char *path, const murk_field *f, char *err, size_t errlen)
 {
-    if (!f || f->kind != FIELD_GRID)
+    if (!f || f->kind == FIELD_CONSTANT)
         return murk_err_file(err, errlen, path, "only grid fields can be saved as .vol (this one is constant)");
+    if (f->affine)
+        return murk_err_file(err, errlen, path, "a grid whose map rotates, shears or mirrors cannot be saved as .vol "
+                             "(a .vol box is axis-aligned)");
+    if (!murk_voxel_count(f->res[0], f->res[1], f->res[2]))
+        return murk_err_file(err, errlen, path, "the grid's box of %d x %d x %d voxels exceeds the limit of %llu voxels "
+                             "of a .vol", f->res[0], f->res[1], f->res[2], (unsigned long long)MURK_FIELD_MAX_VOXELS);
     vol_out o = {path, f};
     return murk_write_atomic(path, vol_fill, &o, err, errlen);
 }

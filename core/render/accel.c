@@ -15,6 +15,14 @@ static void embree_error(void *user, enum RTCError code, const char *str)
     murk_log(MURK_LOG_WARN, "embree error %d: %s", (int)code, str ? str : "");
 }
 
+/* Embree's memory monitor: what it allocates and frees for the scene (called from its build threads). */
+static bool embree_memory(void *user, ssize_t bytes, bool post)
+{
+    (void)post;
+    __atomic_fetch_add(&((murk_scene *)user)->embree_bytes, (long long)bytes, __ATOMIC_RELAXED);
+    return true;
+}
+
 int murk_accel_build(murk_scene *s, char *err, size_t errlen)
 {
     s->device = rtcNewDevice(NULL);
@@ -23,6 +31,8 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
         return -1;
     }
     rtcSetDeviceErrorFunction(s->device, embree_error, NULL);
+    s->embree_bytes = 0;
+    rtcSetDeviceMemoryMonitorFunction(s->device, embree_memory, s);
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
     rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);

@@ -114,26 +114,12 @@ int murk_follow_pass(murk_session *ss)
     return 1;
 }
 
-/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
-static long peak_rss_kb(void)
-{
-    FILE *f = fopen("/proc/self/status", "r");
-    char line[256];
-    long kb = -1;
-    while (f && fgets(line, sizeof line, f))
-        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
-            break;
-    if (f)
-        fclose(f);
-    return kb;
-}
-
 void murk_follow_end(murk_session *ss)
 {
     while (!ss->over)
         murk_follow_pass(ss);
     if (getenv("MURK_MPI_STATS")) /* what this rank held at most (tests/test_mpi.c) */
-        fprintf(stderr, "murk: mpi: rank %d: peak resident memory %ld kB\n", murk_mpi_rank(), peak_rss_kb());
+        fprintf(stderr, "murk: mpi: rank %d: peak resident memory %ld kB\n", murk_mpi_rank(), murk_peak_rss_kb());
     if (ss->rc == 0)
         sum_over_ranks(ss);
 }

@@ -28,6 +28,7 @@ typedef struct murk_shape {
     uint32_t *idx;                             /* 3*ntris */
     murk_vec3 center;                          /* sphere */
     float radius;
+    char *name;                                /* mesh: its file as the scene names it (owned), else NULL */
 } murk_shape;
 
 /* What a light is: an emitting triangle or sphere of a shape (render/lights.c), or one of the scene's
@@ -94,6 +95,11 @@ struct murk_scene {
     /* plugins and their instances */
     murk_named_material *materials;
     size_t nmaterials;
+    /* materials made from an asset's own (shapes: - { type: asset, material: from_file }), each with the
+     * YAML text of its parameters (load/asset.c) */
+    murk_named_material **asset_materials;
+    struct murk_ydoc **asset_docs;
+    size_t nasset_materials;
     murk_named_medium *media;
     size_t nmedia;
     const murk_plugin *integrator_plugin;
@@ -124,6 +130,7 @@ struct murk_scene {
     int legacy_lights; /* the integrator predates MURK_ABI_MINOR_LIGHTS: the added lights get pmf 0 */
     RTCDevice device;
     RTCScene rtc;
+    long long embree_bytes; /* what Embree holds for the scene (its memory monitor: BVH, buffers) */
 };
 
 #endif

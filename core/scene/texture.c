@@ -16,6 +16,7 @@ struct murk_texture {
     float even[3], odd[3];
     float su, sv;     /* uv scale */
     murk_image img;   /* TEX_IMAGE */
+    char file[256];   /* TEX_IMAGE: the file as the scene names it */
     double avg[3];
 };
 
@@ -92,6 +93,7 @@ murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, do
         }
         if ((c = murk_ymap_get(n, "scale")) && scale2(c, &t->su, &t->sv, err, errlen))
             goto fail;
+        snprintf(t->file, sizeof t->file, "%s", f->str);
         char *path = murk_path_relative_to(scene_path, f->str);
         char ierr[768];
         int rc = murk_png_read(path, srgb, &t->img, ierr, sizeof ierr);
@@ -149,6 +151,13 @@ void murk_texture_eval(const murk_texture *t, const murk_hit *hit, float out[3])
 }
 
 void murk_texture_average(const murk_texture *t, double out[3]) { memcpy(out, t->avg, sizeof t->avg); }
+
+size_t murk_texture_bytes(const murk_texture *t, const char **name)
+{
+    if (name)
+        *name = t->kind == TEX_IMAGE ? t->file : "checker";
+    return sizeof *t + (t->kind == TEX_IMAGE ? 3 * (size_t)t->img.w * (size_t)t->img.h * sizeof(float) : 0);
+}
 
 void murk_texture_free(murk_texture *t)
 {

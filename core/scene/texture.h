@@ -19,5 +19,8 @@ murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, do
 void murk_texture_eval(const murk_texture *t, const murk_hit *hit, float out[3]);
 void murk_texture_average(const murk_texture *t, double out[3]);
 void murk_texture_free(murk_texture *t);
+/* Bytes the texture holds (its texels as floats, and itself); *name (if name) its file as the scene names it,
+ * or "checker". */
+size_t murk_texture_bytes(const murk_texture *t, const char **name);
 
 #endif

@@ -16,6 +16,7 @@ static const struct {
     [MURK_LIMIT_FILE_BYTES] = {"MURK_MAX_FILE_BYTES", (uint64_t)1 << 30},
     [MURK_LIMIT_MESH_TRIANGLES] = {"MURK_MAX_MESH_TRIANGLES", (uint64_t)1 << 26},
     [MURK_LIMIT_PAGE_BYTES] = {"MURK_MAX_PAGE_BYTES", (uint64_t)1 << 26},
+    [MURK_LIMIT_GRID_BOX] = {"MURK_MAX_GRID_BOX", (uint64_t)1 << 40},
 };
 
 static uint64_t value[MURK_LIMIT_COUNT];

@@ -12,10 +12,11 @@
 
 typedef enum murk_limit_id {
     MURK_LIMIT_IMAGE_PIXELS,   /* pixels of an image read (texture, compare) or rendered: 2^26 */
-    MURK_LIMIT_GRID_VOXELS,    /* voxels of a density grid (.vol, densified .nvdb, baked cloud): 2^27 */
+    MURK_LIMIT_GRID_VOXELS,    /* voxels of a density grid (.vol, baked cloud) or stored in a sparse one's bricks: 2^27 */
     MURK_LIMIT_FILE_BYTES,     /* bytes of one input file (OBJ mesh, density grid): 2^30 */
-    MURK_LIMIT_MESH_TRIANGLES, /* triangles of one OBJ mesh: 2^26 */
+    MURK_LIMIT_MESH_TRIANGLES, /* triangles of one mesh (OBJ, or all of an asset's): 2^26 */
     MURK_LIMIT_PAGE_BYTES,     /* image data of a comparison page (report.html), base64 bytes: 2^26 */
+    MURK_LIMIT_GRID_BOX,       /* voxels of a sparse grid's (.vdb, .nvdb) index box: 2^40 */
     MURK_LIMIT_COUNT
 } murk_limit_id;
 

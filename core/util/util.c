@@ -165,3 +165,17 @@ MURK_API char *murk_printable(char *dst, size_t n, const char *src)
     dst[k] = 0;
     return dst;
 }
+
+/* The peak resident memory of this process in kB (VmHWM), -1 where /proc does not say. */
+MURK_API long murk_peak_rss_kb(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    long kb = -1;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return kb;
+}

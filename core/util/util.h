@@ -20,6 +20,7 @@ const char *murk_did_you_mean(const char *word, const char *const *candidates, s
 char *murk_path_relative_to(const char *path, const char *rel);
 double murk_now(void); /* monotonic seconds */
 int murk_cpus_usable(void); /* CPUs this process may run on (its affinity mask), at least 1 (cpus.c) */
+long murk_peak_rss_kb(void); /* the peak resident memory of this process in kB (VmHWM), -1 where /proc does not say */
 /* Untrusted text made safe to print on one line: control characters (C0, DEL, C1) and bytes that are
  * not valid UTF-8 become escapes (\n, \t, \r, \e, \\xNN, \\u00NN); printable ASCII and valid UTF-8 pass.
  * Writes at most n bytes including the NUL (cut short at a character boundary) and returns dst. The

@@ -1,0 +1,369 @@
+/* vdb_shim.cpp — the only C++ in murk: reads one scalar grid of an OpenVDB file with libopenvdb (Museth
+ * 2013, "VDB: High-resolution sparse volumes with dynamic topology", ACM TOG 32(3)) and hands its active
+ * tiles and leaves to murk's sparse grid builder through the C interface of vdb_shim.h.
+ *
+ * Memory: the grid is read whole (OpenVDB has no streaming reader), then its leaves are stolen from the
+ * tree one by one and each is freed as soon as the sink has copied it; murk's bricks are allocated at the
+ * size of a leaf's buffer, so the allocator reuses the freed buffers and the peak stays near one copy of
+ * the grid (sparse.c). Delayed loading is off: it would map the file and keep its pages resident.
+ *
+ * Output: libopenvdb logs through log4cplus to std::cout / std::cerr. While it runs, both streams are
+ * captured (one reader at a time), and what it said is appended to an error message; nothing reaches
+ * murk's own output. */
+#include "vdb_shim.h"
+
+#include <openvdb/Grid.h>
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::mutex reader_lock;
+
+/* Redirects std::cout, std::cerr and std::clog into a string while alive. */
+class Capture {
+public:
+    Capture() : out(std::cout.rdbuf(buf.rdbuf())), er(std::cerr.rdbuf(buf.rdbuf())), lg(std::clog.rdbuf(buf.rdbuf())) {}
+    ~Capture()
+    {
+        std::cout.rdbuf(out);
+        std::cerr.rdbuf(er);
+        std::clog.rdbuf(lg);
+    }
+    Capture(const Capture &) = delete;
+    Capture &operator=(const Capture &) = delete;
+    /* What was logged, on one line, without terminal colour codes. */
+    std::string text() const
+    {
+        std::string s = buf.str(), t;
+        for (size_t i = 0; i < s.size(); i++) {
+            if (s[i] == '\033') { /* ESC [ ... letter */
+                while (i < s.size() && !((s[i] >= 'a' && s[i] <= 'z') || (s[i] >= 'A' && s[i] <= 'Z')))
+                    i++;
+                continue;
+            }
+            char c = s[i] == '\n' || s[i] == '\r' || s[i] == '\t' ? ' ' : s[i];
+            if (!(c == ' ' && (t.empty() || t.back() == ' ')))
+                t += c;
+        }
+        while (!t.empty() && t.back() == ' ')
+            t.pop_back();
+        return t;
+    }
+
+private:
+    std::stringstream buf;
+    std::streambuf *out, *er, *lg;
+};
+
+struct Failure {
+    std::string msg;
+};
+
+/* A -1 from a sink callback: its message is in err already. */
+struct SinkFailed {};
+
+void check(int rc)
+{
+    if (rc != 0)
+        throw SinkFailed();
+}
+
+std::string coord(const openvdb::Coord &c)
+{
+    return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
+}
+
+/* The names of the file's grids, quoted and comma-separated. */
+std::string grid_names(openvdb::io::File &file)
+{
+    std::string s;
+    for (auto it = file.beginName(); it != file.endName(); ++it)
+        s += (s.empty() ? "'" : ", '") + *it + "'";
+    return s.empty() ? "none" : s;
+}
+
+/* ---- a check of the file's framing before libopenvdb reads it ----------------------------------------
+ * libopenvdb trusts the lengths and counts the file states: a metadata count, a string's length or a root
+ * node's tile count that claims more than the file holds makes it allocate by the claim and loop on a failed
+ * stream (a hang the fuzz harness found). So the parts that carry such claims are walked here first, each
+ * against the bytes that remain: the header, the file's metadata, every grid descriptor (its offsets in
+ * order inside the file), each grid's metadata and transform, and a float or double grid's root counts.
+ * What lies inside the nodes (masks, values, compressed blocks) is of fixed size or checked by libopenvdb. */
+class Framing {
+public:
+    explicit Framing(const char *path) : in(path, std::ios::binary)
+    {
+        if (!in)
+            throw Failure{"cannot open it"};
+        in.seekg(0, std::ios::end);
+        size = static_cast<uint64_t>(in.tellg());
+        in.seekg(0);
+    }
+    void check()
+    {
+        if (u64() != 0x56444220u)
+            throw Failure{"not a VDB file (bad magic)"};
+        version = u32();
+        if (version < 222 || version > 300)
+            throw Failure{"OpenVDB file format version " + std::to_string(version) + "; murk reads 222 (OpenVDB 3) and later"};
+        skip(8); /* library version */
+        char offsets = static_cast<char>(u8());
+        skip(36); /* uuid, as text */
+        if (!offsets)
+            throw Failure{"the file has no grid offsets (written as a stream); murk reads files written by io::File"};
+        meta_map("the file's metadata");
+        uint32_t grids = u32();
+        for (uint32_t g = 0; g < grids; g++)
+            descriptor(g);
+    }
+
+private:
+    std::ifstream in;
+    uint64_t size = 0, pos = 0;
+    uint32_t version = 0;
+
+    void need(uint64_t n, const std::string &what)
+    {
+        if (n > size - pos)
+            throw Failure{"truncated: " + what + " at byte " + std::to_string(pos) + " claims " + std::to_string(n) +
+                          " bytes, " + std::to_string(size - pos) + " remain"};
+    }
+    void read(void *p, uint64_t n)
+    {
+        need(n, "a field");
+        in.read(static_cast<char *>(p), static_cast<std::streamsize>(n));
+        pos += n;
+    }
+    uint64_t u64() { uint64_t v; read(&v, 8); return v; }
+    uint32_t u32() { uint32_t v; read(&v, 4); return v; }
+    uint8_t u8() { uint8_t v; read(&v, 1); return v; }
+    void skip(uint64_t n, const std::string &what = "a field")
+    {
+        need(n, what);
+        seek(pos + n);
+    }
+    void seek(uint64_t p)
+    {
+        pos = p;
+        in.seekg(static_cast<std::streamoff>(p));
+    }
+    std::string str(const std::string &what)
+    {
+        uint32_t n = u32();
+        need(n, what);
+        std::string s(n, '\0');
+        read(&s[0], n);
+        return s;
+    }
+    /* A MetaMap: a count, then (name, type name, byte count, value) each. */
+    void meta_map(const std::string &what)
+    {
+        uint32_t n = u32();
+        need(12ull * n, what + " (" + std::to_string(n) + " entries)");
+        for (uint32_t i = 0; i < n; i++) {
+            str(what + ": a name");
+            str(what + ": a type name");
+            skip(u32(), what + ": a value");
+        }
+    }
+    /* A grid descriptor and the head of its grid: metadata, transform, root counts. */
+    void descriptor(uint32_t g)
+    {
+        std::string name = str("a grid's name"), type = str("a grid's type");
+        bool instance = !str("a grid's instance parent").empty(); /* an instance has no topology of its own */
+        uint64_t grid = u64(), block = u64(), end = u64();
+        if (!(pos <= grid && grid <= block && block <= end && end <= size))
+            throw Failure{"grid " + std::to_string(g) + " ('" + name + "') has offsets " + std::to_string(grid) + ", " +
+                          std::to_string(block) + ", " + std::to_string(end) + " outside the file's " +
+                          std::to_string(size) + " bytes"};
+        uint64_t next = end;
+        uint64_t limit = size;
+        size = block; /* the head lies before the grid's buffers */
+        seek(grid);
+        skip(4, "a grid's compression"); /* compression flags */
+        meta_map("grid '" + name + "' metadata");
+        transform(name);
+        int vsize = type.rfind("Tree_float_5_4_3", 0) == 0 ? 4 : type.rfind("Tree_double_5_4_3", 0) == 0 ? 8 : 0;
+        if (vsize && !instance) { /* Tree::readTopology's buffer count, then the root: background, tiles, children */
+            skip(4 + static_cast<uint64_t>(vsize), "a grid's root");
+            uint64_t tiles = u32(), children = u32();
+            need(tiles * (13 + static_cast<uint64_t>(vsize)) + children * 12, "grid '" + name + "' root (" +
+                 std::to_string(tiles) + " tiles, " + std::to_string(children) + " children)");
+        }
+        size = limit;
+        seek(next);
+    }
+    /* Transform::read: a map type name, then the map (its size by type; a frustum is refused later). */
+    void transform(const std::string &name)
+    {
+        std::string map = str("grid '" + name + "' transform");
+        static const std::pair<const char *, uint64_t> sizes[] = {
+            {"AffineMap", 128}, {"UnitaryMap", 128}, {"ScaleMap", 120}, {"UniformScaleMap", 120},
+            {"ScaleTranslateMap", 144}, {"UniformScaleTranslateMap", 144}, {"TranslationMap", 24}};
+        for (const auto &m : sizes)
+            if (map == m.first) {
+                skip(m.second, "grid '" + name + "' " + map);
+                return;
+            }
+        throw Failure{"grid '" + name + "' has a non-linear (" + map.substr(0, 64) + ") transform; murk takes affine maps"};
+    }
+};
+
+/* Tiles first (at every level above the leaves), then the leaves, stolen from the tree and freed one by one. */
+template <typename GridT> void send(GridT &grid, const murk_vdb_sink *sink, char *err, size_t errlen)
+{
+    using TreeT = typename GridT::TreeType;
+    using LeafT = typename TreeT::LeafNodeType;
+    TreeT &tree = grid.tree();
+    auto tiles = tree.cbeginValueOn();
+    tiles.setMaxDepth(tiles.getLeafDepth() - 1);
+    for (; tiles; ++tiles) {
+        openvdb::CoordBBox bb;
+        tiles.getBoundingBox(bb);
+        double v = static_cast<double>(*tiles);
+        int o[3] = {bb.min().x(), bb.min().y(), bb.min().z()};
+        float f = static_cast<float>(v);
+        if (std::isfinite(v) && !std::isfinite(f))
+            throw Failure{"a tile value " + std::to_string(v) + " is beyond the range of float"};
+        check(sink->tile(sink->user, o, static_cast<long long>(bb.dim().x()), f, err, errlen));
+    }
+    std::vector<LeafT *> leaves;
+    leaves.reserve(tree.leafCount());
+    tree.stealNodes(leaves);
+    float values[LeafT::SIZE];
+    uint64_t mask[LeafT::SIZE / 64];
+    size_t i = 0;
+    try {
+        for (; i < leaves.size(); i++) {
+            LeafT *leaf = leaves[i];
+            const auto *data = leaf->buffer().data();
+            for (openvdb::Index k = 0; k < LeafT::SIZE; k++) {
+                values[k] = static_cast<float>(data[k]);
+                if (std::isfinite(static_cast<double>(data[k])) && !std::isfinite(values[k]) &&
+                    leaf->getValueMask().isOn(k))
+                    throw Failure{"value " + std::to_string(static_cast<double>(data[k])) + " at voxel " +
+                                  coord(leaf->offsetToGlobalCoord(k)) + " is beyond the range of float"};
+            }
+            for (openvdb::Index w = 0; w < LeafT::SIZE / 64; w++)
+                mask[w] = leaf->getValueMask().template getWord<uint64_t>(w);
+            const openvdb::Coord &c = leaf->origin();
+            int o[3] = {c.x(), c.y(), c.z()};
+            delete leaf;
+            leaves[i] = nullptr;
+            check(sink->leaf(sink->user, o, values, mask, err, errlen));
+        }
+    } catch (...) {
+        for (; i < leaves.size(); i++)
+            delete leaves[i];
+        throw;
+    }
+}
+
+void read_grid(const char *path, const char *name, uint64_t max_active, const murk_vdb_sink *sink, murk_vdb_meta *meta,
+               char *err, size_t errlen)
+{
+    try {
+        Framing(path).check();
+    } catch (const Failure &f) {
+        throw Failure{"not a readable OpenVDB file: " + f.msg};
+    }
+    openvdb::io::File file(path);
+    file.open(false); /* no delayed loading */
+    std::string gname;
+    if (name) {
+        if (!file.hasGrid(name)) {
+            meta->no_such_grid = 1;
+            throw Failure{std::string("no grid '") + name + "'; the file has " + grid_names(file)};
+        }
+        gname = name;
+    } else {
+        int n = 0;
+        for (auto it = file.beginName(); it != file.endName(); ++it, n++)
+            gname = *it;
+        if (n != 1)
+            throw Failure{"the file holds " + std::to_string(n) + " grids (" + grid_names(file) +
+                          "); name one with grid: NAME"};
+    }
+    openvdb::GridBase::Ptr head = file.readGridMetadata(gname);
+    const std::string type = head->valueType();
+    if (type != "float" && type != "double")
+        throw Failure{"grid '" + gname + "' holds " + type + " values; murk reads scalar float, half or double grids"};
+    if (head->getGridClass() == openvdb::GRID_LEVEL_SET)
+        throw Failure{"grid '" + gname + "' is a level set (signed distances), not a density (a fog volume); "
+                      "convert it, e.g. with openvdb::tools::sdfToFogVolume"};
+    auto claimed = head->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
+    if (claimed && (claimed->value() < 0 || static_cast<uint64_t>(claimed->value()) > max_active))
+        throw Failure{"grid '" + gname + "' has " + std::to_string(claimed->value()) +
+                      " active voxels, more than the limit of " + std::to_string(max_active)};
+    openvdb::GridBase::Ptr g = file.readGrid(gname);
+    file.close();
+    const openvdb::math::Transform &xf = g->transform();
+    if (!xf.isLinear())
+        throw Failure{"grid '" + gname + "' has a non-linear (" + xf.mapType() + ") transform; murk takes affine maps"};
+    openvdb::math::Mat4d m = xf.baseMap()->getAffineMap()->getMat4(); /* row vectors: world = ijk * m */
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++)
+            meta->map[4 * r + c] = m(c, r);
+        meta->map[4 * r + 3] = m(3, r);
+    }
+    openvdb::CoordBBox bb = g->evalActiveVoxelBoundingBox();
+    if (bb.empty())
+        throw Failure{"grid '" + gname + "' has no active voxels"};
+    int bmin[3] = {bb.min().x(), bb.min().y(), bb.min().z()}, bmax[3] = {bb.max().x(), bb.max().y(), bb.max().z()};
+    check(sink->begin(sink->user, bmin, bmax, err, errlen));
+    if (auto fg = openvdb::gridPtrCast<openvdb::FloatGrid>(g)) {
+        meta->background = fg->background();
+        send(*fg, sink, err, errlen);
+    } else if (auto dg = openvdb::gridPtrCast<openvdb::DoubleGrid>(g)) {
+        meta->background = dg->background();
+        send(*dg, sink, err, errlen);
+    } else {
+        throw Failure{"grid '" + gname + "' is of type " + g->type() + "; murk reads float, half or double trees of "
+                      "OpenVDB's standard configuration (5, 4, 3)"};
+    }
+}
+
+} // namespace
+
+extern "C" int murk_vdb_read(const char *path, const char *grid, uint64_t max_active, const murk_vdb_sink *sink,
+                             murk_vdb_meta *meta, char *err, size_t errlen)
+{
+    static std::once_flag init;
+    std::lock_guard<std::mutex> hold(reader_lock);
+    *meta = murk_vdb_meta();
+    std::string what;
+    {
+        Capture quiet;
+        try {
+            std::call_once(init, [] { openvdb::initialize(); });
+            read_grid(path, grid, max_active, sink, meta, err, errlen);
+            return 0;
+        } catch (const SinkFailed &) {
+            return -1;
+        } catch (const Failure &f) {
+            what = f.msg;
+        } catch (const std::bad_alloc &) {
+            what = "out of memory";
+        } catch (const std::exception &e) {
+            what = std::string("not a readable OpenVDB file: ") + e.what();
+        } catch (...) {
+            what = "not a readable OpenVDB file";
+        }
+        std::string said = quiet.text();
+        if (!said.empty())
+            what += " (openvdb: " + said + ")";
+    }
+    if (err && errlen)
+        std::snprintf(err, errlen, "%s: %s", path, what.c_str());
+    return -1;
+}

@@ -1,0 +1,496 @@
+/* test_assets.c — `type: asset` shapes read through Assimp (core/load/asset.c), against the same things said in
+ * murk's own terms. Every file is written here: OBJ, PLY and glTF (JSON with an embedded buffer, and binary
+ * .glb) by hand, FBX by Assimp's own exporter (its ASCII form: Debian's Assimp 5.2.5 cannot read back its
+ * binary FBX). The mesh's coordinates are multiples of 1/64, exact in every format (FBX ASCII prints 6
+ * decimals), so each file holds the same floats.
+ *
+ *   formats      the mesh as .obj (murk's reader, type: mesh), and as .obj, .ply, .gltf, .glb, .fbx through
+ *                Assimp: bitwise the same image; one vertex moved by 1/64 must differ.
+ *   material     a glTF metallic-roughness material (base colour, metallic 0.25, roughness 0.6, an emissive
+ *                factor) with material: from_file renders bitwise as the
+ *                OBJ with the documented ggx (albedo = base (1 - m), specular = 0.04 (1 - m) + base m) and the
+ *                emission; the ggx without the metallic mix (albedo = base) must differ.
+ *   camera       a glTF camera node (translated, rotated, yfov) taken with camera: { from_asset: N } renders as
+ *                the YAML camera at its place; a yfov 5 % wider must differ.
+ *   lights       KHR_lights_punctual point and directional lights render as the `lights:` block's.
+ *   scene        tools/make_gem.py writes the bytes committed in scenes/gem/ (twice the same), and
+ *                scenes/gem_asset.yaml (a PLY and a glTF with its materials, camera and spot lamp) renders a few
+ *                spp with every pixel finite and >= 0.
+ *   bad input    no mesh, a NaN vertex, a missing buffer, random bytes, truncated JSON, an unknown extension, a
+ *                directory, from_asset naming a quad or an asset without a camera: `murk render` exits 1 with
+ *                "scene.yaml:LINE:COL:" and writes no image. */
+#include "testutil.h"
+#include "image/image.h"
+
+#ifdef MURK_HAVE_ASSIMP
+#include <assimp/cexport.h>
+#include <assimp/cimport.h>
+#include <assimp/scene.h>
+#endif
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+/* A gem: 6 vertices, 8 triangles, outward winding; coordinates in 1/64 steps. */
+static const float V[6][3] = {{0, 0.125f, 0}, {0.375f, 0.5f, 0.0625f}, {-0.0625f, 0.5f, 0.375f},
+                              {-0.34375f, 0.5f, -0.125f}, {0.0625f, 0.5f, -0.3125f}, {0, 0.90625f, 0}};
+static const unsigned F[8][3] = {{0, 2, 1}, {0, 3, 2}, {0, 4, 3}, {0, 1, 4}, {5, 1, 2}, {5, 2, 3}, {5, 3, 4}, {5, 4, 1}};
+
+static void write_file(const char *path, const void *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_true(fwrite(data, 1, n, f) == n);
+    assert_int_equal(fclose(f), 0);
+}
+
+static const char *write_obj(const char *name, float dy)
+{
+    char text[2048];
+    size_t k = 0;
+    for (int i = 0; i < 6; i++)
+        k += (size_t)snprintf(text + k, sizeof text - k, "v %.9g %.9g %.9g\n", (double)V[i][0],
+                              (double)(V[i][1] + (i == 5 ? dy : 0.0f)), (double)V[i][2]);
+    for (int t = 0; t < 8; t++)
+        k += (size_t)snprintf(text + k, sizeof text - k, "f %u %u %u\n", F[t][0] + 1, F[t][1] + 1, F[t][2] + 1);
+    return write_tmp(name, text);
+}
+
+static const char *write_ply(const char *name)
+{
+    char text[2048];
+    size_t k = (size_t)snprintf(text, sizeof text, "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\n"
+                                "property float y\nproperty float z\nelement face 8\nproperty list uchar int vertex_indices\n"
+                                "end_header\n");
+    for (int i = 0; i < 6; i++)
+        k += (size_t)snprintf(text + k, sizeof text - k, "%.9g %.9g %.9g\n", (double)V[i][0], (double)V[i][1], (double)V[i][2]);
+    for (int t = 0; t < 8; t++)
+        k += (size_t)snprintf(text + k, sizeof text - k, "3 %u %u %u\n", F[t][0], F[t][1], F[t][2]);
+    return write_tmp(name, text);
+}
+
+/* The mesh's buffer: 6 float3 positions (72 bytes), then 24 uint16 indices (48 bytes). */
+static size_t mesh_buffer(unsigned char *b, int nan_vertex)
+{
+    float p[18];
+    for (int i = 0; i < 6; i++)
+        for (int a = 0; a < 3; a++)
+            p[3 * i + a] = V[i][a];
+    if (nan_vertex)
+        p[7] = NAN;
+    memcpy(b, p, sizeof p);
+    for (int t = 0; t < 8; t++)
+        for (int k = 0; k < 3; k++) {
+            uint16_t v = (uint16_t)F[t][k];
+            memcpy(b + 72 + 2 * (3 * t + k), &v, 2);
+        }
+    return 120;
+}
+
+static void base64(const unsigned char *in, size_t n, char *out)
+{
+    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t k = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        unsigned v = (unsigned)in[i] << 16 | (i + 1 < n ? (unsigned)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+        out[k++] = a[v >> 18];
+        out[k++] = a[(v >> 12) & 63];
+        out[k++] = i + 1 < n ? a[(v >> 6) & 63] : '=';
+        out[k++] = i + 2 < n ? a[v & 63] : '=';
+    }
+    out[k] = 0;
+}
+
+/* A glTF document around the mesh: `uri` is the buffer's (NULL: none, for a .glb's BIN chunk), `extra_nodes`
+ * and `extra` are spliced in (nodes after node 0; top-level members), `material` is material 0's JSON (NULL:
+ * none). */
+static void gltf_json(char *out, size_t n, const char *uri, const char *material, const char *extra_nodes,
+                      const char *extra, int nodes)
+{
+    char list[128] = "0";
+    for (int i = 1; i < nodes; i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), ", %d", i);
+    snprintf(out, n,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [%s]}],\n"
+             "\"nodes\": [{\"name\": \"gem\", \"mesh\": 0}%s],\n"
+             "\"meshes\": [{\"name\": \"gem\", \"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1%s}]}],\n"
+             "%s%s%s"
+             "\"buffers\": [{\"byteLength\": 120%s%s%s}],\n"
+             "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 72}, {\"buffer\": 0, \"byteOffset\": 72, "
+             "\"byteLength\": 48}],\n"
+             "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 6, \"type\": \"VEC3\", "
+             "\"min\": [-0.34375, 0.125, -0.3125], \"max\": [0.375, 0.90625, 0.375]},\n"
+             "  {\"bufferView\": 1, \"componentType\": 5123, \"count\": 24, \"type\": \"SCALAR\"}]}\n",
+             list, extra_nodes ? extra_nodes : "", material ? ", \"material\": 0" : "", material ? "\"materials\": [" : "",
+             material ? material : "", material ? "],\n" : "", uri ? ", \"uri\": \"" : "", uri ? uri : "", uri ? "\"" : "");
+    if (extra && *extra) { /* before the closing brace */
+        size_t l = strlen(out);
+        while (l && out[l - 1] != '}')
+            l--;
+        snprintf(out + l - 1, n - (l - 1), ",\n%s}\n", extra);
+    }
+}
+
+static const char *write_gltf(const char *name, const char *material, const char *extra_nodes, const char *extra,
+                              int nodes, int nan_vertex)
+{
+    unsigned char b[128];
+    char uri[300], text[8192];
+    size_t n = mesh_buffer(b, nan_vertex);
+    strcpy(uri, "data:application/octet-stream;base64,");
+    base64(b, n, uri + strlen(uri));
+    gltf_json(text, sizeof text, uri, material, extra_nodes, extra, nodes);
+    return write_tmp(name, text);
+}
+
+static const char *write_glb(const char *name)
+{
+    unsigned char bin[128], out[8192];
+    char json[4096];
+    size_t nb = mesh_buffer(bin, 0);
+    gltf_json(json, sizeof json, NULL, NULL, NULL, NULL, 1);
+    size_t nj = strlen(json);
+    while (nj % 4)
+        json[nj++] = ' ';
+    size_t total = 12 + 8 + nj + 8 + nb;
+    uint32_t h[3] = {0x46546C67u, 2, (uint32_t)total}, cj[2] = {(uint32_t)nj, 0x4E4F534Au}, cb[2] = {(uint32_t)nb, 0x004E4942u};
+    memcpy(out, h, 12);
+    memcpy(out + 12, cj, 8);
+    memcpy(out + 20, json, nj);
+    memcpy(out + 20 + nj, cb, 8);
+    memcpy(out + 28 + nj, bin, nb);
+    static char p[512];
+    snprintf(p, sizeof p, "%s", tmp_path(name));
+    write_file(p, out, total);
+    return p;
+}
+
+#ifdef MURK_HAVE_ASSIMP
+/* The OBJ written again as ASCII FBX by Assimp's exporter. */
+static const char *write_fbx(const char *name, const char *obj)
+{
+    const struct aiScene *s = aiImportFile(obj, 0);
+    if (!s)
+        fail_msg("Assimp cannot read %s: %s", obj, aiGetErrorString());
+    static char p[512];
+    snprintf(p, sizeof p, "%s", tmp_path(name));
+    if (aiExportScene(s, "fbxa", p, 0) != AI_SUCCESS)
+        fail_msg("Assimp cannot write %s: %s", p, aiGetErrorString());
+    aiReleaseImport(s);
+    return p;
+}
+#endif
+
+/* A small lit room around the mesh shape `shape` (a YAML flow map), with `camera` and `extra` (more top-level
+ * YAML) if given; rendered at 32x32, 16 spp, seed 3 into tmp_dir()/out. */
+static const char *render_scene(const char *shape, const char *materials, const char *camera, const char *extra,
+                                const char *out)
+{
+    char text[4096];
+    snprintf(text, sizeof text,
+             "murk: 1\nrender: { resolution: [32, 32], spp: 16, seed: 3 }\n"
+             "camera: %s\n"
+             "materials:\n  white: { type: diffuse, albedo: 0.7 }\n  shiny: { type: ggx, albedo: 0.5, specular: 0.3, roughness: 0.4 }\n%s"
+             "%s"
+             "shapes:\n  - { type: quad, center: [0, 0, 0], u: [2, 0, 0], v: [0, 0, -2], material: white }\n"
+             "  - { type: quad, center: [0, 2, 0], u: [0.3, 0, 0], v: [0, 0, 0.3], material: shiny, emission: [12, 12, 12] }\n"
+             "  - %s\n",
+             camera ? camera : "{ from: [0.3, 0.8, 2.2], at: [0, 0.5, 0], fov: 40 }", materials ? materials : "",
+             extra ? extra : "", shape);
+    const char *scene = write_tmp("asset_scene.yaml", text), *path = tmp_path(out);
+    const char *args[] = {"render", scene, "-o", path, "--threads", "2", "--quiet", NULL};
+    run_murk_ok(args, NULL);
+    static char keep[8][512];
+    static int next;
+    char *k = keep[next++ & 7];
+    snprintf(k, sizeof keep[0], "%s", path);
+    return k;
+}
+
+static void need_assimp(void)
+{
+#ifndef MURK_HAVE_ASSIMP
+    skip();
+#endif
+}
+
+static int nfail;
+
+static void expect(int same, int want, const char *what)
+{
+    printf("  %-60s %s%s\n", what, same ? "bitwise the same" : "DIFFER", same == want ? "" : "  <-- FAIL");
+    nfail += same != want;
+}
+
+static void test_formats(void **state)
+{
+    (void)state;
+    need_assimp();
+    nfail = 0;
+    char shape[1200], obj[512];
+    snprintf(obj, sizeof obj, "%s", write_obj("gem.obj", 0.0f));
+    snprintf(shape, sizeof shape, "{ type: mesh, file: %s, material: shiny }", obj);
+    const char *ref = render_scene(shape, NULL, NULL, NULL, "ref.exr");
+    char files[5][512]; /* copies: the helpers' paths are rotating buffers */
+    snprintf(files[0], sizeof files[0], "%s", obj);
+    snprintf(files[1], sizeof files[1], "%s", write_ply("gem.ply"));
+    snprintf(files[2], sizeof files[2], "%s", write_gltf("gem.gltf", NULL, NULL, NULL, 1, 0));
+    snprintf(files[3], sizeof files[3], "%s", write_glb("gem.glb"));
+    snprintf(files[4], sizeof files[4], "%s", "none.fbx");
+#ifdef MURK_HAVE_ASSIMP
+    snprintf(files[4], sizeof files[4], "%s", write_fbx("gem.fbx", obj));
+#endif
+    static const char *const labels[5] = {"OBJ through Assimp", "PLY", "glTF (JSON, embedded buffer)", "glTF binary (.glb)",
+                                          "FBX (ASCII, written by Assimp)"};
+    for (int i = 0; i < 5; i++) {
+        snprintf(shape, sizeof shape, "{ type: asset, file: %.511s, material: shiny }", files[i]);
+        expect(same_pixels(render_scene(shape, NULL, NULL, NULL, "asset.exr"), ref), 1, labels[i]);
+    }
+    const char *moved = write_obj("gem_moved.obj", 0.015625f); /* must-fail: the apex 1/64 higher */
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: shiny }", moved);
+    expect(same_pixels(render_scene(shape, NULL, NULL, NULL, "moved.exr"), ref), 0, "the apex 1/64 higher (must DIFFER)");
+    assert_int_equal(nfail, 0);
+}
+
+static void test_material(void **state)
+{
+    (void)state;
+    need_assimp();
+    nfail = 0;
+    const char *mat = "{\"name\": \"copper\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.3, 0.2, 1], "
+                      "\"metallicFactor\": 0.25, \"roughnessFactor\": 0.6}, \"emissiveFactor\": [1, 0.5, 0.25]}";
+    const char *g = write_gltf("mat.gltf", mat, NULL, NULL, 1, 0);
+    char shape[600], mats[600];
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }", g);
+    const char *a = render_scene(shape, NULL, NULL, NULL, "mat_gltf.exr");
+    /* the documented mapping, in float as asset.c computes it */
+    float base[3] = {0.8f, 0.3f, 0.2f}, m = 0.25f, al[3], sp[3];
+    for (int c = 0; c < 3; c++) {
+        al[c] = base[c] * (1.0f - m);
+        sp[c] = 0.04f * (1.0f - m) + base[c] * m;
+    }
+    for (int k = 0; k < 2; k++) {
+        snprintf(mats, sizeof mats, "  mapped: { type: ggx, albedo: [%.9g, %.9g, %.9g], specular: [%.9g, %.9g, %.9g], "
+                 "roughness: %.9g }\n", (double)(k ? base[0] : al[0]), (double)(k ? base[1] : al[1]),
+                 (double)(k ? base[2] : al[2]), (double)sp[0], (double)sp[1], (double)sp[2], (double)0.6f);
+        snprintf(shape, sizeof shape, "{ type: mesh, file: %s, material: mapped, emission: [1, 0.5, 0.25] }",
+                 write_obj("gem.obj", 0.0f));
+        const char *b = render_scene(shape, mats, NULL, NULL, k ? "mat_unmixed.exr" : "mat_obj.exr");
+        expect(same_pixels(a, b), !k, k ? "albedo = base colour, no metallic mix (must DIFFER)"
+                                        : "glTF material from_file = OBJ with the mapped ggx and emission");
+    }
+    assert_int_equal(nfail, 0);
+}
+
+/* The rotation matrix of a quaternion (x, y, z, w as glTF writes it) in float, as Assimp's aiQuaternion::GetMatrix
+ * computes it (the node transforms asset.c reads are Assimp's float matrices). */
+static void qmat(const float q[4], float m[9])
+{
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    m[0] = 1.0f - 2.0f * (y * y + z * z), m[1] = 2.0f * (x * y - z * w), m[2] = 2.0f * (x * z + y * w);
+    m[3] = 2.0f * (x * y + z * w), m[4] = 1.0f - 2.0f * (x * x + z * z), m[5] = 2.0f * (y * z - x * w);
+    m[6] = 2.0f * (x * z - y * w), m[7] = 2.0f * (y * z + x * w), m[8] = 1.0f - 2.0f * (x * x + y * y);
+}
+
+static void test_camera(void **state)
+{
+    (void)state;
+    need_assimp();
+    nfail = 0;
+    /* the camera turned 0.4 rad about y, then tilted 0.3 rad down about its x: q = qy qx */
+    double a = 0.2, b = -0.15, qy[4] = {0, sin(a), 0, cos(a)}, qx[4] = {sin(b), 0, 0, cos(b)};
+    float q[4] = {(float)(qy[3] * qx[0] + qy[0] * qx[3] + qy[1] * qx[2] - qy[2] * qx[1]),
+                  (float)(qy[3] * qx[1] - qy[0] * qx[2] + qy[1] * qx[3] + qy[2] * qx[0]),
+                  (float)(qy[3] * qx[2] + qy[0] * qx[1] - qy[1] * qx[0] + qy[2] * qx[3]),
+                  (float)(qy[3] * qx[3] - qy[0] * qx[0] - qy[1] * qx[1] - qy[2] * qx[2])};
+    float t[3] = {0.875f, 1.125f, 2.0f}, yfov = 0.75f;
+    char nodes[600], extra[300], shape[600], cam[600];
+    snprintf(nodes, sizeof nodes, ", {\"name\": \"view\", \"camera\": 0, \"translation\": [%.9g, %.9g, %.9g], "
+             "\"rotation\": [%.9g, %.9g, %.9g, %.9g]}", (double)t[0], (double)t[1], (double)t[2], (double)q[0],
+             (double)q[1], (double)q[2], (double)q[3]);
+    snprintf(extra, sizeof extra, "\"cameras\": [{\"name\": \"view\", \"type\": \"perspective\", \"perspective\": "
+             "{\"yfov\": %.9g, \"aspectRatio\": 1.0, \"znear\": 0.01}}]", (double)yfov);
+    const char *g = write_gltf("cam.gltf", NULL, nodes, extra, 2, 0);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: shiny }", g);
+    const char *img = render_scene(shape, NULL, "{ from_asset: 2 }", NULL, "cam_gltf.exr");
+    /* the same camera written out: from = t, at = t + R (0, 0, -1), up = R (0, 1, 0), fov = yfov in degrees */
+    float m[9];
+    qmat(q, m);
+    for (int k = 0; k < 2; k++) {
+        double fov = (double)yfov * (k ? 1.05 : 1.0) * 180.0 / M_PI;
+        snprintf(cam, sizeof cam, "{ from: [%.9g, %.9g, %.9g], at: [%.9g, %.9g, %.9g], up: [%.9g, %.9g, %.9g], fov: %.9g }",
+                 (double)t[0], (double)t[1], (double)t[2], (double)(float)((double)t[0] - m[2]),
+                 (double)(float)((double)t[1] - m[5]), (double)(float)((double)t[2] - m[8]), (double)m[1], (double)m[4],
+                 (double)m[7], (double)(float)fov);
+        expect(same_pixels(img, render_scene(shape, NULL, cam, NULL, "cam_yaml.exr")), !k,
+               k ? "the yfov 5 % wider (must DIFFER)" : "glTF camera (from_asset) = the YAML camera at its place");
+    }
+    assert_int_equal(nfail, 0);
+}
+
+static void test_lights(void **state)
+{
+    (void)state;
+    need_assimp();
+    nfail = 0;
+    const float q[4] = {-0.382683432f, 0, 0, 0.923879533f}; /* -45 degrees about x */
+    char nodes[600], lights[600], shape[600];
+    snprintf(nodes, sizeof nodes, ", {\"name\": \"bulb\", \"translation\": [0.5, 1.25, 0.75], \"extensions\": "
+             "{\"KHR_lights_punctual\": {\"light\": 0}}}, {\"name\": \"sun\", \"rotation\": [%.9g, 0, 0, %.9g], "
+             "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}}", (double)q[0], (double)q[3]);
+    const char *extra = "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": "
+                        "{\"lights\": [{\"type\": \"point\", \"color\": [1, 0.5, 0.25], \"intensity\": 2}, "
+                        "{\"type\": \"directional\", \"color\": [1, 1, 1], \"intensity\": 0.5}]}}";
+    const char *g = write_gltf("lights.gltf", NULL, nodes, extra, 3, 0);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: shiny }", g);
+    const char *img = render_scene(shape, NULL, NULL, NULL, "lights_gltf.exr");
+    float m[9]; /* the sun shines along R (0, 0, -1): its direction towards the light is R (0, 0, 1) */
+    qmat(q, m);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: shiny, lights: false }", g); /* its lights left out */
+    for (int k = 0; k < 2; k++) {
+        snprintf(lights, sizeof lights, "lights:\n  - { type: point, position: [0.5, 1.25, 0.75], intensity: [2, 1, 0.5] }\n"
+                 "  - { type: distant, direction: [%.9g, %.9g, %.9g], irradiance: %s, angular_diameter: 0 }\n",
+                 (double)m[2], (double)m[5], (double)m[8], k ? "0.6" : "0.5");
+        expect(same_pixels(img, render_scene(shape, NULL, NULL, lights, "lights_yaml.exr")), !k,
+               k ? "the sun 20 % brighter (must DIFFER)" : "glTF point + directional = the lights: block's");
+    }
+    assert_int_equal(nfail, 0);
+}
+
+/* `murk render` of the room with shape: exit 1, "scene:LINE:COL: ... needle", no image. */
+static void expect_error(const char *shape, const char *camera, const char *needle)
+{
+    char text[2048];
+    snprintf(text, sizeof text, "murk: 1\nrender: { resolution: [8, 8], spp: 1 }\n%s%s%s"
+             "materials:\n  white: { type: diffuse }\nshapes:\n  - { type: quad, center: [0, 0, 0], u: [1, 0, 0], "
+             "v: [0, 0, -1], material: white }\n  - %s\n", camera ? "camera: " : "", camera ? camera : "",
+             camera ? "\n" : "", shape);
+    const char *scene = write_tmp("bad_asset.yaml", text), *out = tmp_path("bad_asset.exr");
+    remove(out);
+    char *log = NULL;
+    const char *args[] = {"render", scene, "-o", out, NULL};
+    int rc = run_murk_argv(&log, args);
+    char where[600];
+    snprintf(where, sizeof where, "%s:", scene);
+    assert_refused(log, rc, where, needle, out);
+}
+
+static void test_bad_input(void **state)
+{
+    (void)state;
+    need_assimp();
+    char shape[700], text[8192];
+    /* no mesh: a document with a camera only */
+    const char *nomesh = write_tmp("nomesh.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], "
+                                   "\"nodes\": [{\"name\": \"c\", \"camera\": 0}], \"cameras\": [{\"type\": \"perspective\", "
+                                   "\"perspective\": {\"yfov\": 0.7, \"znear\": 0.1}}]}");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", nomesh);
+    expect_error(shape, NULL, "holds no triangle mesh");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", write_gltf("nan.gltf", NULL, NULL, NULL, 1, 1));
+    expect_error(shape, NULL, "vertex 2 is not finite");
+    gltf_json(text, sizeof text, "missing.bin", NULL, NULL, NULL, 1);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", write_tmp("nobuffer.gltf", text));
+    expect_error(shape, NULL, "Assimp cannot read it");
+    unsigned char junk[3000];
+    for (size_t i = 0; i < sizeof junk; i++)
+        junk[i] = (unsigned char)(i * 7919u >> 3);
+    write_file(tmp_path("junk.glb"), junk, sizeof junk);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", tmp_path("junk.glb"));
+    expect_error(shape, NULL, "Assimp cannot read it");
+    gltf_json(text, sizeof text, "x", NULL, NULL, NULL, 1);
+    text[strlen(text) / 2] = 0;
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", write_tmp("cut.gltf", text));
+    expect_error(shape, NULL, "Assimp cannot read it");
+    expect_error("{ type: asset, file: model.stl, material: white }", NULL, "not a file murk reads as an asset");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s/, material: white }", tmp_dir());
+    expect_error(shape, NULL, "not a file murk reads as an asset");
+    mkdir(tmp_path("dir.gltf"), 0700);
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", tmp_path("dir.gltf"));
+    expect_error(shape, NULL, "not a regular file");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s }", write_gltf("g.gltf", NULL, NULL, NULL, 1, 0));
+    expect_error(shape, NULL, "asset has no material");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", write_gltf("g.gltf", NULL, NULL, NULL, 1, 0));
+    expect_error(shape, "{ from_asset: 0 }", "shapes[0] is not an asset shape");
+    expect_error(shape, "{ from_asset: 1 }", "the file has no camera");
+    expect_error(shape, "{ from_asset: 1, asset_camera: main }", "no camera 'main'");
+    expect_error(shape, "{ from_asset: 1, from: [0, 0, 1] }", "'from' and from_asset exclude each other");
+}
+
+/* 1 if the files at a and b hold the same bytes. */
+static int same_bytes(const char *a, const char *b)
+{
+    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
+    int same = fa && fb;
+    while (same) {
+        int ca = fgetc(fa), cb = fgetc(fb);
+        same = ca == cb;
+        if (ca == EOF)
+            break;
+    }
+    if (fa)
+        fclose(fa);
+    if (fb)
+        fclose(fb);
+    return same;
+}
+
+static void test_scene(void **state)
+{
+    (void)state;
+    need_assimp();
+    static const char *const files[] = {"gem.gltf", "gem.ply"};
+    for (int run = 0; run < 2; run++) {
+        char dir[600], a[700], b[700];
+        snprintf(dir, sizeof dir, "%s/gem%d", tmp_dir(), run);
+        pid_t pid = fork();
+        if (pid == 0) {
+            if (!freopen("/dev/null", "w", stdout))
+                _exit(127);
+            execl("/usr/bin/python3", "/usr/bin/python3", src_path("tools/make_gem.py"), dir, (char *)NULL);
+            _exit(127);
+        }
+        int st = 0;
+        assert_true(pid > 0 && waitpid(pid, &st, 0) == pid && WIFEXITED(st) && WEXITSTATUS(st) == 0);
+        for (int i = 0; i < 2; i++) {
+            snprintf(a, sizeof a, "%s/%s", dir, files[i]);
+            snprintf(b, sizeof b, "scenes/gem/%s", files[i]);
+            if (!same_bytes(a, src_path(b)))
+                fail_msg("%s differs from the committed %s: run tools/make_gem.py", a, b);
+        }
+    }
+    const char *exr = tmp_path("gem_asset.exr");
+    const char *args[] = {"render", src_path("scenes/gem_asset.yaml"), "-o", exr, "--spp", "4", "--set",
+                          "render.resolution=[40,30]", "--quiet", NULL};
+    run_murk_ok(args, NULL);
+    murk_image img = {0};
+    char err[512];
+    assert_int_equal(murk_exr_read(exr, &img, err, sizeof err), 0);
+    double sum = 0.0;
+    for (int i = 0; i < 3 * img.w * img.h; i++) {
+        assert_true(isfinite(img.rgb[i]) && img.rgb[i] >= 0.0f);
+        sum += img.rgb[i];
+    }
+    printf("  gem_asset 40x30, 4 spp: mean %.4f\n", sum / (3.0 * img.w * img.h));
+    assert_true(sum > 0.0);
+    murk_image_free(&img);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_formats),
+        cmocka_unit_test(test_material),
+        cmocka_unit_test(test_camera),
+        cmocka_unit_test(test_lights),
+        cmocka_unit_test(test_scene),
+        cmocka_unit_test(test_bad_input),
+    };
+    if (getenv("MURK_TEST_FILTER"))
+        cmocka_set_test_filter(getenv("MURK_TEST_FILTER"));
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
