@@ -34,6 +34,21 @@ BUILTINS=$(find "$TMP/root" -type f -name diffuse.so -path '*/murk/plugins/*' | 
 [ -n "$EXAMPLES" ] || fail "no share/murk/examples installed"
 [ -n "$BUILTINS" ] || fail "no built-in plugins installed"
 BUILTINS=$(dirname "$BUILTINS")
+SHARE=$(dirname "$(dirname "$EXAMPLES")") # PREFIX/share
+
+step "the docs, the starter scenes and the examples' scene are installed"
+for f in doc/murk/README.md doc/murk/docs/plugins.md doc/murk/docs/trackers.md murk/scenes/cornell.yaml \
+         murk/scenes/cornell_smoke.yaml murk/examples/examples.yaml murk/examples/README.md; do
+  [ -s "$SHARE/$f" ] || fail "share/$f is not installed"
+done
+grep -q "murk's sources" "$EXAMPLES/README.md" && fail "the installed examples' README points into murk's sources"
+
+step "murk help names the installed docs, examples and scenes"
+env -u LD_LIBRARY_PATH "$MURK" help >"$TMP/help.txt" || fail "murk help"
+REALSHARE=$(realpath "$SHARE")
+for f in "$REALSHARE/doc/murk/docs/plugins.md" "$REALSHARE/murk/examples" "$REALSHARE/murk/scenes"; do
+  grep -qF "$f" "$TMP/help.txt" || { cat "$TMP/help.txt"; fail "murk help does not name $f"; }
+done
 
 step "the installed murk finds libmurk through its RPATH"
 readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
@@ -55,7 +70,7 @@ env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" plugins diffuse >"$TMP/builti
   { cat "$TMP/builtin.txt"; fail "the installed murk does not find the built-in diffuse"; }
 grep -qF "file: $(realpath "$BUILTINS")/diffuse.so" "$TMP/builtin.txt" ||
   { cat "$TMP/builtin.txt"; fail "diffuse.so was not taken from the installed plugin folder $BUILTINS"; }
-env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "${MURK_SOURCE_ROOT:?}/scenes/cornell_smoke.yaml" \
+env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "$SHARE/murk/scenes/cornell_smoke.yaml" \
   -o "$TMP/builtin.exr" --spp 1 --set 'render.resolution=[16,16]' --quiet || fail "the installed murk does not render"
 [ -s "$TMP/builtin.exr" ] || fail "the installed murk wrote no image"
 
@@ -67,6 +82,9 @@ CFLAGS=$(pkg-config --cflags murk-plugin)
 echo "cflags: $CFLAGS"
 echo "libs: $LIBS"
 echo "plugindir: $(pkg-config --variable=plugindir murk-plugin), ABI $(pkg-config --variable=abi_major murk-plugin).$(pkg-config --variable=abi_minor murk-plugin)"
+for v in docdir scenesdir examplesdir; do
+  [ -d "$(pkg-config --variable=$v murk-plugin)" ] || fail "murk-plugin.pc's $v is not an installed folder"
+done
 case " $LIBS " in *" -lmurk "*) fail "murk-plugin links libmurk" ;; esac
 case " $LIBS " in *" -lm "*) ;; *) fail "murk-plugin lacks -lm" ;; esac
 case " $CFLAGS " in *"-fvisibility=hidden"*) ;; *) fail "murk-plugin lacks -fvisibility=hidden" ;; esac
@@ -76,6 +94,9 @@ cp -R "$EXAMPLES" "$TMP/examples"
 "$MESON" setup "$TMP/examples/build" "$TMP/examples" >"$TMP/setup.log" 2>&1 || { cat "$TMP/setup.log"; fail "meson setup of the examples"; }
 "$MESON" compile -C "$TMP/examples/build" >"$TMP/compile.log" 2>&1 || { cat "$TMP/compile.log"; fail "building the examples"; }
 grep -i "warning" "$TMP/compile.log" && fail "the examples compile with warnings"
+# a release build by default: -O0 (meson's default) would make an example tracker time slower than it is
+"$MESON" introspect --buildoptions "$TMP/examples/build" | tr -d ' \n' | grep -q '"name":"buildtype","value":"release"' ||
+  fail "the examples' meson.build does not default to a release build"
 EXB="$TMP/examples/build"
 for p in example_matte example_delta example_bsdfpath; do
   [ -f "$EXB/$p.so" ] || fail "$p.so was not built"
@@ -100,22 +121,8 @@ step "murk check on each example"
 "$MURK" check --quick example_delta || fail "murk check example_delta"
 "$MURK" check --quick example_bsdfpath || fail "murk check example_bsdfpath"
 
-step "render a scene that names all three"
-cat >"$TMP/examples.yaml" <<'EOF'
-murk: 1
-render: { resolution: [32, 24], spp: 8, seed: 3 }
-camera: { from: [0, 1, 3.4], at: [0, 0.7, 0], up: [0, 1, 0], fov: 40 }
-integrator: { type: example_bsdfpath, max_depth: 8 }
-background: [0.6, 0.7, 0.9]
-materials:
-  matte: { type: example_matte, color: [0.8, 0.7, 0.5], tint: [1, 0.9, 0.9] }
-media:
-  haze: { type: example_delta, density: { constant: 1 }, sigma_a: 0.05, sigma_s: [0.9, 0.6, 0.3] }
-shapes:
-  - { type: quad, center: [0, 0, 0], u: [2, 0, 0], v: [0, 0, -2], material: matte }
-  - { type: sphere, center: [0, 0.7, 0], radius: 0.5, material: matte, exterior: haze }
-  - { type: box, min: [-1, 0.05, -1], max: [1, 1.5, 1], interior: haze }
-EOF
+step "render the examples' scene, which names all three"
+cp "$TMP/examples/examples.yaml" "$TMP/examples.yaml"
 "$MURK" render "$TMP/examples.yaml" -o "$TMP/examples.exr" --threads 2 || fail "murk render"
 [ -s "$TMP/examples.exr" ] && [ -s "$TMP/examples.png" ] || fail "murk render wrote no image"
 # example_bsdfpath passes media by; volpath_nee traces example_delta's free flights through the haze

@@ -696,6 +696,51 @@ static int cmd_grid(int argc, char **argv)
     return rc ? 1 : 0;
 }
 
+/* The data folder (holding murk/examples, murk/scenes, doc/murk) of the running murk: DATADIR relative to
+ * its executable if that holds murk's examples (an install, moved or staged with --destdir), else the
+ * configured prefix's. */
+static void installed_datadir(char *out, size_t n)
+{
+    char exe[4096], dir[4096 + 64];
+    ssize_t k = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (k > 0) {
+        exe[k] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash) {
+            *slash = 0;
+            snprintf(dir, sizeof dir, "%s/%s/murk/examples", exe, MURK_DATADIR_FROM_BINDIR);
+            char real[4096];
+            if (realpath(dir, real) && strlen(real) > strlen("/murk/examples")) {
+                real[strlen(real) - strlen("/murk/examples")] = 0;
+                snprintf(out, n, "%s", real);
+                return;
+            }
+        }
+    }
+    snprintf(out, n, "%s", MURK_DATADIR);
+}
+
+/* `murk help`'s last lines: where the guide, the example plugins and the starter scenes are, for this
+ * murk (the sources' when it runs from its build tree). */
+static void print_files(void)
+{
+    if (murk_running_uninstalled()) {
+        printf("\nfiles (murk runs from its build tree: the sources at %s)\n"
+               "  docs         %s/README.md, %s/docs/plugins.md (writing plugins)\n"
+               "  examples     %s/plugins/examples (three plugins to copy, their meson.build, examples.yaml)\n"
+               "  scenes       %s/scenes\n",
+               MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT);
+        return;
+    }
+    char d[4096];
+    installed_datadir(d, sizeof d);
+    printf("\nfiles\n"
+           "  docs         %s/doc/murk/README.md, %s/doc/murk/docs/plugins.md (writing plugins)\n"
+           "  examples     %s/murk/examples (three plugins to copy, their meson.build, examples.yaml)\n"
+           "  scenes       %s/murk/scenes (starter scenes)\n",
+           d, d, d, d);
+}
+
 int murk_cli_main(int argc, char **argv)
 {
     if (argc < 2)
@@ -707,6 +752,7 @@ int murk_cli_main(int argc, char **argv)
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
         fputs(murk_cli_usage_text, stdout);
+        print_files();
         return 0;
     }
     int known = 0;
