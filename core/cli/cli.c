@@ -551,8 +551,9 @@ static int render_loaded(render_args *ra, const murk_scene *s, volatile sig_atom
     }
     murk_warn_summary();
     if (res.nonfinite)
-        murk_log(MURK_LOG_WARN, "integrator '%s' returned %llu NaN or infinite samples; they were left out of their "
-                 "pixels", s->integrator_plugin->desc->name, (unsigned long long)res.nonfinite);
+        murk_log(MURK_LOG_WARN, "integrator '%s' [%s] returned %llu NaN or infinite samples; they were left out of "
+                 "their pixels", s->integrator_plugin->desc->name, s->integrator_plugin->path,
+                 (unsigned long long)res.nonfinite);
     free(res.rgb);
     return rc;
 }
