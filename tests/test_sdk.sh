@@ -15,26 +15,8 @@
 # sets it). Writes nothing outside one temporary folder, which it removes.
 set -eu
 MESON=${1:-meson}
-BUILD=${MURK_BUILD_ROOT:?MURK_BUILD_ROOT must name the build folder}
-TMP=$(mktemp -d "${TMPDIR:-/tmp}/murk-sdk-XXXXXX")
-trap 'rm -rf "$TMP"' EXIT INT TERM
-export TMPDIR="$TMP" # murk check's scratch folder too
-step() { printf '== %s\n' "$*"; }
-fail() { printf 'FAIL: %s\n' "$*"; exit 1; }
-
-step "meson install --destdir $TMP/root"
-"$MESON" install -C "$BUILD" --destdir "$TMP/root" --no-rebuild --quiet >"$TMP/install.log" 2>&1 ||
-  { cat "$TMP/install.log"; fail "meson install"; }
-MURK=$(find "$TMP/root" -type f -name murk -path '*/bin/murk' | head -n 1)
-PCFILE=$(find "$TMP/root" -name murk-plugin.pc | head -n 1)
-EXAMPLES=$(find "$TMP/root" -type d -path '*/share/murk/examples' | head -n 1)
-BUILTINS=$(find "$TMP/root" -type f -name diffuse.so -path '*/murk/plugins/*' | head -n 1)
-[ -n "$MURK" ] || fail "no bin/murk installed"
-[ -n "$PCFILE" ] || fail "no murk-plugin.pc installed"
-[ -n "$EXAMPLES" ] || fail "no share/murk/examples installed"
-[ -n "$BUILTINS" ] || fail "no built-in plugins installed"
-BUILTINS=$(dirname "$BUILTINS")
-SHARE=$(dirname "$(dirname "$EXAMPLES")") # PREFIX/share
+. "$(dirname "$0")/sdk_lib.sh"
+sdk_install
 
 step "the docs, the starter scenes and the examples' scene are installed"
 for f in doc/murk/README.md doc/murk/docs/plugins.md doc/murk/docs/trackers.md murk/scenes/cornell.yaml \
@@ -75,8 +57,6 @@ env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "$SHARE/murk/scenes/co
 [ -s "$TMP/builtin.exr" ] || fail "the installed murk wrote no image"
 
 step "murk-plugin.pc: headers, -lm, hidden visibility, no -lmurk"
-export PKG_CONFIG_PATH="$(dirname "$PCFILE")"
-export PKG_CONFIG_SYSROOT_DIR="$TMP/root" # the files name the real prefix; they live under the destdir
 LIBS=$(pkg-config --libs murk-plugin)
 CFLAGS=$(pkg-config --cflags murk-plugin)
 echo "cflags: $CFLAGS"
@@ -89,17 +69,8 @@ case " $LIBS " in *" -lmurk "*) fail "murk-plugin links libmurk" ;; esac
 case " $LIBS " in *" -lm "*) ;; *) fail "murk-plugin lacks -lm" ;; esac
 case " $CFLAGS " in *"-fvisibility=hidden"*) ;; *) fail "murk-plugin lacks -fvisibility=hidden" ;; esac
 
-step "build the installed examples out of tree"
-cp -R "$EXAMPLES" "$TMP/examples"
-"$MESON" setup "$TMP/examples/build" "$TMP/examples" >"$TMP/setup.log" 2>&1 || { cat "$TMP/setup.log"; fail "meson setup of the examples"; }
-"$MESON" compile -C "$TMP/examples/build" >"$TMP/compile.log" 2>&1 || { cat "$TMP/compile.log"; fail "building the examples"; }
-grep -i "warning" "$TMP/compile.log" && fail "the examples compile with warnings"
-# a release build by default: -O0 (meson's default) would make an example tracker time slower than it is
-"$MESON" introspect --buildoptions "$TMP/examples/build" | tr -d ' \n' | grep -q '"name":"buildtype","value":"release"' ||
-  fail "the examples' meson.build does not default to a release build"
-EXB="$TMP/examples/build"
+sdk_build_examples
 for p in example_matte example_delta example_bsdfpath; do
-  [ -f "$EXB/$p.so" ] || fail "$p.so was not built"
   nm -D --defined-only "$EXB/$p.so" | grep -q murk_plugin_entry || fail "$p.so does not export murk_plugin_entry"
   nm -D --undefined-only "$EXB/$p.so" | grep -q 'murk' && fail "$p.so needs a symbol from libmurk"
   readelf -d "$EXB/$p.so" | grep -q 'libmurk' && fail "$p.so links libmurk"
