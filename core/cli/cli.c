@@ -86,11 +86,14 @@ static const struct command_help {
      "bitwise identical to a single-process render. Every part 0..N-1 must be given once, whole, and of the\n"
      "same render (scene, --set, seed, spp, size, split, murk version, plugins); otherwise the error names it.\n"},
     {"check",
-     "usage: murk check [--seed S] [--quick] PLUGIN...\n"
+     "usage: murk check [--seed S] [--quick] [--set KEY=VALUE]... PLUGIN...\n"
      "Runs murk's statistical tests on plugins (by name or .so path): chi-square, reciprocity and furnace for\n"
-     "materials; closed-form transmittance and cross-tracker agreement for trackers; a furnace for integrators.\n"
-     "  --seed S   the random seed (default fixed)\n"
-     "  --quick    fewer samples\n"},
+     "materials; closed-form transmittance, cross-tracker agreement and heavy tails for trackers; a furnace for\n"
+     "integrators. Each plugin runs with its defaults, every range at 25 % and 75 %, and each parameter alone at\n"
+     "both ends of its range and at every enum and bool value; each in a process of its own (a crash is a FAIL).\n"
+     "  --seed S          the random seed (default fixed)\n"
+     "  --quick           fewer samples\n"
+     "  --set KEY=VALUE   check one plugin at these parameter values (repeatable) instead of the sweep\n"},
     {"grid",
      "usage: murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O]\n"
      "                 [--coverage C]\n"
