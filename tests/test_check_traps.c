@@ -8,7 +8,9 @@
  *   gain      trap_gain, 20 % too much energy: the furnace fails at albedo 1 (the range's end), 1.2, and
  *             nowhere else (0.9 at 75 % passes: why the old sets missed it);
  *   heavy     trap_heavy, unbounded weights in `mode: eager` (unbiased): the variance lines fail there
- *             (variance beyond 20x the analog estimator's), never in `mode: bounded`.
+ *             (variance beyond 20x the analog estimator's), never in `mode: bounded`;
+ *   estimator trap_tr_roulette, a transmittance estimator that keeps 1 estimate in 50 (x 50): its
+ *             variance lines fail, nothing else.
  * And the output: a PASS line never shows |z| > 4 (zero-variance figures say they were compared
  * exactly); NaN is named; a missing plugin and a crashing one give a FAIL line with the reason, the
  * summary line and exit 1. All deterministic: murk check's seeds are fixed. */
@@ -111,6 +113,18 @@ static void test_heavy(void **state)
     free(out);
 }
 
+/* An estimator kept 1 in 50 (x 50): unbiased, its variance lines fail (34x to 86x), nothing else. */
+static void test_estimator(void **state)
+{
+    (void)state;
+    char *out = NULL;
+    int rc = check(&out, "trap_tr_roulette", NULL);
+    printf("%s", out);
+    assert_int_equal(rc, 1);
+    assert_true(fails_only(out, "defaults", " variance ") >= 3);
+    free(out);
+}
+
 /* No PASS line shows a z beyond the bound; zero-variance figures say how they were compared. */
 static void test_honest_pass(void **state)
 {
@@ -158,6 +172,7 @@ static void test_honest_fail(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_rate), cmocka_unit_test(test_gain), cmocka_unit_test(test_heavy),
+                                       cmocka_unit_test(test_estimator),
                                        cmocka_unit_test(test_honest_pass), cmocka_unit_test(test_honest_fail)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

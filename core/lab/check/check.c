@@ -54,6 +54,7 @@
 #include "util/util.h"
 #include "murk/lab.h"
 #include "murk/murk.h"
+#include "murk/transmittance.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -614,14 +615,14 @@ static void figure(ck *c, const char *label, const char *what, const acc3 *a, lo
 
 /* Two estimates of the same figure agree: |z| <= 4 on their difference, or, both without variance (as in
  * judge()), equal up to float rounding. */
-static void compare(ck *c, const char *label, const char *what, const acc3 *a, const acc3 *b, long n)
+static void compare(ck *c, const char *label, const char *what, const acc3 *a, long n, const acc3 *b, long nb)
 {
     char line[384];
     size_t k = 0;
     int ok = 1;
     for (int ch = 0; ch < 3; ch++) {
-        double ma = acc_mean(a, ch, n), mb = acc_mean(b, ch, n), d = ma - mb;
-        double se = hypot(acc_se(a, ch, n), acc_se(b, ch, n)), scale = fmax(fabs(ma), fabs(mb));
+        double ma = acc_mean(a, ch, n), mb = acc_mean(b, ch, nb), d = ma - mb;
+        double se = hypot(acc_se(a, ch, n), acc_se(b, ch, nb)), scale = fmax(fabs(ma), fabs(mb));
         if (!isfinite(d)) {
             ok = 0;
             k += (size_t)snprintf(line + k, sizeof line - k, "  NaN or infinite");
@@ -682,6 +683,9 @@ static murk_scene *load_medium(ck *c, const char *type, const mconfig *cfg, char
     return load_text(c, "medium.yaml", text, err, errlen);
 }
 
+/* Calls per configuration: 100000, --quick 20000, and a quarter of that at a --quick sweep point. */
+static long sweep_count(const ck *c, const ck_set *set) { return c->quick ? (set->full ? 20000 : 5000) : 100000; }
+
 /* Heavy tails. A tracker or estimator with unbounded weights may be unbiased and pass every mean above
  * (the standard error is taken from the same samples, and a tail that the samples rarely reach inflates
  * neither), yet be useless in a render (a relMSE 10^5 times delta tracking's). Per channel: the sample
@@ -737,12 +741,13 @@ static void medium_closed_form(const mconfig *cfg, murk_ray *ray, double *D, dou
 
 /* One configuration of one parameter set; ref: the built-in delta tracker's figures on it (run once per
  * configuration, *have_ref then 1; -1 if there is no delta to compare with). */
-static void medium_config(ck *c, const murk_plugin_desc *d, const char *keys, int i, tstats *ref, int *have_ref)
+static void medium_config(ck *c, const murk_plugin_desc *d, const ck_set *set, int i, tstats *ref, int *have_ref)
 {
+    const char *keys = set->keys;
     static const mconfig cfgs[4] = {
         {"slab, grey", 0, 0}, {"slab, chromatic", 1, 0}, {"checker, grey", 0, 1}, {"checker, chromatic", 1, 1}};
     const mconfig *cfg = &cfgs[i];
-    long n = c->quick ? 20000 : 100000;
+    long n = sweep_count(c, set);
     char err[1024], type[1400];
     murk_ray ray;
     double D, T[3], S[3], B[NBINS][3];
@@ -787,9 +792,9 @@ static void medium_config(ck *c, const murk_plugin_desc *d, const char *keys, in
         murk_scene_free(rs);
         *have_ref = 1;
     }
-    compare(c, cfg->name, "T", &st.T, &ref->T, n);
-    compare(c, cfg->name, "pass", &st.pass, &ref->pass, n);
-    compare(c, cfg->name, "scatter", &st.scat, &ref->scat, n);
+    compare(c, cfg->name, "T", &st.T, n, &ref->T, ref->n);
+    compare(c, cfg->name, "pass", &st.pass, n, &ref->pass, ref->n);
+    compare(c, cfg->name, "scatter", &st.scat, n, &ref->scat, ref->n);
 }
 
 static void check_medium(ck *c, const murk_plugin_desc *d)
@@ -806,7 +811,61 @@ static void check_medium(ck *c, const murk_plugin_desc *d)
     for (int set = 0; set < nsets; set++) {
         printf("  set %d: %s\n", set, sets[set].what);
         for (int i = 0; i < 4; i++)
-            medium_config(c, d, sets[set].keys, i, &ref[i], &have_ref[i]);
+            medium_config(c, d, &sets[set], i, &ref[i], &have_ref[i]);
+    }
+}
+
+/* ---- transmittance estimators: heavy tails -------------------------------------------------------- */
+
+/* An estimator (murk/transmittance.h) under the built-in delta tracker, called as a shadow ray calls it
+ * (murk_medium_transmittance, a uniform hero, beta 1) n times on each configuration of the trackers'
+ * checks, at each parameter set: every estimate finite, and its tail() lines. */
+static void check_estimator_tails(ck *c, const murk_plugin_desc *d)
+{
+    static const mconfig cfgs[4] = {
+        {"slab, grey", 0, 0}, {"slab, chromatic", 1, 0}, {"checker, grey", 0, 1}, {"checker, chromatic", 1, 1}};
+    static ck_set sets[CK_MAX_SETS];
+    char err[1024];
+    if (write_checker(c, err, sizeof err)) {
+        report(c, 0, "checker grid: %s", err);
+        return;
+    }
+    int nsets = param_sets(c, d, sets);
+    for (int set = 0; set < nsets; set++) {
+        printf("  set %d: %s\n", set, sets[set].what);
+        long n = sweep_count(c, &sets[set]);
+        for (int i = 0; i < 4; i++) {
+            const mconfig *cfg = &cfgs[i];
+            murk_ray ray;
+            double D, T[3], S[3], B[NBINS][3];
+            medium_closed_form(cfg, &ray, &D, T, S, B);
+            char type[1600];
+            snprintf(type, sizeof type, "delta, transmittance: { type: %s%.1023s }", d->name, sets[set].keys);
+            murk_scene *s = load_medium(c, type, cfg, err, sizeof err);
+            if (!s) {
+                report(c, 0, "%-26s create() failed: %s", cfg->name, err);
+                continue;
+            }
+            murk_rng rng;
+            murk_rng_seed(&rng, c->seed + 200u + (uint64_t)i, 0x7461696c73ull, 8);
+            murk_path_ctx ctx;
+            memset(&ctx, 0, sizeof ctx);
+            ctx.beta = murk_rgb1(1.0f);
+            acc3 acc;
+            memset(&acc, 0, sizeof acc);
+            long nonfinite = 0;
+            for (long k = 0; k < n; k++) {
+                ctx.hero = (int)(murk_rng_float(&rng) * 3.0f);
+                murk_rgb t = murk_medium_transmittance(&s->media[0].m, &ray, &ctx, &rng);
+                nonfinite += !murk_rgb_finite(t);
+                for (int ch = 0; ch < 3; ch++)
+                    acc_add(&acc, ch, murk_rgb_finite(t) ? t.c[ch] : 0.0);
+            }
+            murk_scene_free(s);
+            printf("  %s: optical depth %.4f, %ld estimates\n", cfg->name, D, n);
+            report(c, nonfinite == 0, "%-26s finite    %ld estimates NaN or infinite", cfg->name, nonfinite);
+            tail(c, cfg->name, "T", &acc, n, T);
+        }
     }
 }
 
@@ -990,6 +1049,8 @@ static int check_one(ck *c, const char *arg)
         check_medium(c, d);
     else if (d->kind == MURK_KIND_INTEGRATOR)
         check_integrator(c, d);
+    else if (d->kind == MURK_KIND_TRANSMITTANCE)
+        check_estimator_tails(c, d);
     printf("%s: %s\n", d->name, c->fails == fails0 ? "all checks passed" : "FAILED");
     murk_registry_free(&reg);
     return c->fails == fails0 ? 0 : 1;
