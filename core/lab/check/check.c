@@ -643,6 +643,10 @@ typedef struct mconfig {
     int chroma, checker;
 } mconfig;
 
+/* The media the trackers (and, under delta, the estimators) are checked on. */
+static const mconfig MEDIUM_CFGS[4] = {
+    {"slab, grey", 0, 0}, {"slab, chromatic", 1, 0}, {"checker, grey", 0, 1}, {"checker, chromatic", 1, 1}};
+
 static const double GREY_SA[3] = {0.3, 0.3, 0.3}, GREY_SS[3] = {0.9, 0.9, 0.9};
 static const double CHROMA_SA[3] = {0.2, 1.0, 3.0}, CHROMA_SS[3] = {1.0, 0.5, 0.1};
 
@@ -744,9 +748,7 @@ static void medium_closed_form(const mconfig *cfg, murk_ray *ray, double *D, dou
 static void medium_config(ck *c, const murk_plugin_desc *d, const ck_set *set, int i, tstats *ref, int *have_ref)
 {
     const char *keys = set->keys;
-    static const mconfig cfgs[4] = {
-        {"slab, grey", 0, 0}, {"slab, chromatic", 1, 0}, {"checker, grey", 0, 1}, {"checker, chromatic", 1, 1}};
-    const mconfig *cfg = &cfgs[i];
+    const mconfig *cfg = &MEDIUM_CFGS[i];
     long n = sweep_count(c, set);
     char err[1024], type[1400];
     murk_ray ray;
@@ -797,17 +799,23 @@ static void medium_config(ck *c, const murk_plugin_desc *d, const ck_set *set, i
     compare(c, cfg->name, "scatter", &st.scat, n, &ref->scat, ref->n);
 }
 
+/* The checker grid written and the parameter sets of d: their count (0 after a FAIL line). */
+static int medium_sets(ck *c, const murk_plugin_desc *d, ck_set *sets)
+{
+    char err[1024];
+    if (write_checker(c, err, sizeof err)) {
+        report(c, 0, "checker grid: %s", err);
+        return 0;
+    }
+    return param_sets(c, d, sets);
+}
+
 static void check_medium(ck *c, const murk_plugin_desc *d)
 {
     static ck_set sets[CK_MAX_SETS];
     tstats ref[4];
     int have_ref[4] = {0, 0, 0, 0};
-    char err[1024];
-    if (write_checker(c, err, sizeof err)) {
-        report(c, 0, "checker grid: %s", err);
-        return;
-    }
-    int nsets = param_sets(c, d, sets);
+    int nsets = medium_sets(c, d, sets);
     for (int set = 0; set < nsets; set++) {
         printf("  set %d: %s\n", set, sets[set].what);
         for (int i = 0; i < 4; i++)
@@ -822,20 +830,14 @@ static void check_medium(ck *c, const murk_plugin_desc *d)
  * checks, at each parameter set: every estimate finite, and its tail() lines. */
 static void check_estimator_tails(ck *c, const murk_plugin_desc *d)
 {
-    static const mconfig cfgs[4] = {
-        {"slab, grey", 0, 0}, {"slab, chromatic", 1, 0}, {"checker, grey", 0, 1}, {"checker, chromatic", 1, 1}};
     static ck_set sets[CK_MAX_SETS];
     char err[1024];
-    if (write_checker(c, err, sizeof err)) {
-        report(c, 0, "checker grid: %s", err);
-        return;
-    }
-    int nsets = param_sets(c, d, sets);
+    int nsets = medium_sets(c, d, sets);
     for (int set = 0; set < nsets; set++) {
         printf("  set %d: %s\n", set, sets[set].what);
         long n = sweep_count(c, &sets[set]);
         for (int i = 0; i < 4; i++) {
-            const mconfig *cfg = &cfgs[i];
+            const mconfig *cfg = &MEDIUM_CFGS[i];
             murk_ray ray;
             double D, T[3], S[3], B[NBINS][3];
             medium_closed_form(cfg, &ray, &D, T, S, B);
