@@ -15,25 +15,22 @@
 # sets it). Writes nothing outside one temporary folder, which it removes.
 set -eu
 MESON=${1:-meson}
-BUILD=${MURK_BUILD_ROOT:?MURK_BUILD_ROOT must name the build folder}
-TMP=$(mktemp -d "${TMPDIR:-/tmp}/murk-sdk-XXXXXX")
-trap 'rm -rf "$TMP"' EXIT INT TERM
-export TMPDIR="$TMP" # murk check's scratch folder too
-step() { printf '== %s\n' "$*"; }
-fail() { printf 'FAIL: %s\n' "$*"; exit 1; }
+. "$(dirname "$0")/sdk_lib.sh"
+sdk_install
 
-step "meson install --destdir $TMP/root"
-"$MESON" install -C "$BUILD" --destdir "$TMP/root" --no-rebuild --quiet >"$TMP/install.log" 2>&1 ||
-  { cat "$TMP/install.log"; fail "meson install"; }
-MURK=$(find "$TMP/root" -type f -name murk -path '*/bin/murk' | head -n 1)
-PCFILE=$(find "$TMP/root" -name murk-plugin.pc | head -n 1)
-EXAMPLES=$(find "$TMP/root" -type d -path '*/share/murk/examples' | head -n 1)
-BUILTINS=$(find "$TMP/root" -type f -name diffuse.so -path '*/murk/plugins/*' | head -n 1)
-[ -n "$MURK" ] || fail "no bin/murk installed"
-[ -n "$PCFILE" ] || fail "no murk-plugin.pc installed"
-[ -n "$EXAMPLES" ] || fail "no share/murk/examples installed"
-[ -n "$BUILTINS" ] || fail "no built-in plugins installed"
-BUILTINS=$(dirname "$BUILTINS")
+step "the docs, the starter scenes and the examples' scene are installed"
+for f in doc/murk/README.md doc/murk/docs/plugins.md doc/murk/docs/trackers.md murk/scenes/cornell.yaml \
+         murk/scenes/cornell_smoke.yaml murk/examples/examples.yaml murk/examples/README.md; do
+  [ -s "$SHARE/$f" ] || fail "share/$f is not installed"
+done
+grep -q "murk's sources" "$EXAMPLES/README.md" && fail "the installed examples' README points into murk's sources"
+
+step "murk help names the installed docs, examples and scenes"
+env -u LD_LIBRARY_PATH "$MURK" help >"$TMP/help.txt" || fail "murk help"
+REALSHARE=$(realpath "$SHARE")
+for f in "$REALSHARE/doc/murk/docs/plugins.md" "$REALSHARE/murk/examples" "$REALSHARE/murk/scenes"; do
+  grep -qF "$f" "$TMP/help.txt" || { cat "$TMP/help.txt"; fail "murk help does not name $f"; }
+done
 
 step "the installed murk finds libmurk through its RPATH"
 readelf -d "$MURK" | grep -E 'R(UN)?PATH' | grep -q 'ORIGIN' || fail "installed murk has no \$ORIGIN RPATH"
@@ -55,30 +52,25 @@ env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" plugins diffuse >"$TMP/builti
   { cat "$TMP/builtin.txt"; fail "the installed murk does not find the built-in diffuse"; }
 grep -qF "file: $(realpath "$BUILTINS")/diffuse.so" "$TMP/builtin.txt" ||
   { cat "$TMP/builtin.txt"; fail "diffuse.so was not taken from the installed plugin folder $BUILTINS"; }
-env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "${MURK_SOURCE_ROOT:?}/scenes/cornell_smoke.yaml" \
+env -u LD_LIBRARY_PATH -u MURK_PLUGIN_PATH "$MURK" render "$SHARE/murk/scenes/cornell_smoke.yaml" \
   -o "$TMP/builtin.exr" --spp 1 --set 'render.resolution=[16,16]' --quiet || fail "the installed murk does not render"
 [ -s "$TMP/builtin.exr" ] || fail "the installed murk wrote no image"
 
 step "murk-plugin.pc: headers, -lm, hidden visibility, no -lmurk"
-export PKG_CONFIG_PATH="$(dirname "$PCFILE")"
-export PKG_CONFIG_SYSROOT_DIR="$TMP/root" # the files name the real prefix; they live under the destdir
 LIBS=$(pkg-config --libs murk-plugin)
 CFLAGS=$(pkg-config --cflags murk-plugin)
 echo "cflags: $CFLAGS"
 echo "libs: $LIBS"
 echo "plugindir: $(pkg-config --variable=plugindir murk-plugin), ABI $(pkg-config --variable=abi_major murk-plugin).$(pkg-config --variable=abi_minor murk-plugin)"
+for v in docdir scenesdir examplesdir; do
+  [ -d "$(pkg-config --variable=$v murk-plugin)" ] || fail "murk-plugin.pc's $v is not an installed folder"
+done
 case " $LIBS " in *" -lmurk "*) fail "murk-plugin links libmurk" ;; esac
 case " $LIBS " in *" -lm "*) ;; *) fail "murk-plugin lacks -lm" ;; esac
 case " $CFLAGS " in *"-fvisibility=hidden"*) ;; *) fail "murk-plugin lacks -fvisibility=hidden" ;; esac
 
-step "build the installed examples out of tree"
-cp -R "$EXAMPLES" "$TMP/examples"
-"$MESON" setup "$TMP/examples/build" "$TMP/examples" >"$TMP/setup.log" 2>&1 || { cat "$TMP/setup.log"; fail "meson setup of the examples"; }
-"$MESON" compile -C "$TMP/examples/build" >"$TMP/compile.log" 2>&1 || { cat "$TMP/compile.log"; fail "building the examples"; }
-grep -i "warning" "$TMP/compile.log" && fail "the examples compile with warnings"
-EXB="$TMP/examples/build"
+sdk_build_examples
 for p in example_matte example_delta example_bsdfpath; do
-  [ -f "$EXB/$p.so" ] || fail "$p.so was not built"
   nm -D --defined-only "$EXB/$p.so" | grep -q murk_plugin_entry || fail "$p.so does not export murk_plugin_entry"
   nm -D --undefined-only "$EXB/$p.so" | grep -q 'murk' && fail "$p.so needs a symbol from libmurk"
   readelf -d "$EXB/$p.so" | grep -q 'libmurk' && fail "$p.so links libmurk"
@@ -100,22 +92,8 @@ step "murk check on each example"
 "$MURK" check --quick example_delta || fail "murk check example_delta"
 "$MURK" check --quick example_bsdfpath || fail "murk check example_bsdfpath"
 
-step "render a scene that names all three"
-cat >"$TMP/examples.yaml" <<'EOF'
-murk: 1
-render: { resolution: [32, 24], spp: 8, seed: 3 }
-camera: { from: [0, 1, 3.4], at: [0, 0.7, 0], up: [0, 1, 0], fov: 40 }
-integrator: { type: example_bsdfpath, max_depth: 8 }
-background: [0.6, 0.7, 0.9]
-materials:
-  matte: { type: example_matte, color: [0.8, 0.7, 0.5], tint: [1, 0.9, 0.9] }
-media:
-  haze: { type: example_delta, density: { constant: 1 }, sigma_a: 0.05, sigma_s: [0.9, 0.6, 0.3] }
-shapes:
-  - { type: quad, center: [0, 0, 0], u: [2, 0, 0], v: [0, 0, -2], material: matte }
-  - { type: sphere, center: [0, 0.7, 0], radius: 0.5, material: matte, exterior: haze }
-  - { type: box, min: [-1, 0.05, -1], max: [1, 1.5, 1], interior: haze }
-EOF
+step "render the examples' scene, which names all three"
+cp "$TMP/examples/examples.yaml" "$TMP/examples.yaml"
 "$MURK" render "$TMP/examples.yaml" -o "$TMP/examples.exr" --threads 2 || fail "murk render"
 [ -s "$TMP/examples.exr" ] && [ -s "$TMP/examples.png" ] || fail "murk render wrote no image"
 # example_bsdfpath passes media by; volpath_nee traces example_delta's free flights through the haze

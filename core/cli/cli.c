@@ -88,11 +88,14 @@ static const struct command_help {
      "bitwise identical to a single-process render. Every part 0..N-1 must be given once, whole, and of the\n"
      "same render (scene, --set, seed, spp, size, split, murk version, plugins); otherwise the error names it.\n"},
     {"check",
-     "usage: murk check [--seed S] [--quick] PLUGIN...\n"
+     "usage: murk check [--seed S] [--quick] [--set KEY=VALUE]... PLUGIN...\n"
      "Runs murk's statistical tests on plugins (by name or .so path): chi-square, reciprocity and furnace for\n"
-     "materials; closed-form transmittance and cross-tracker agreement for trackers; a furnace for integrators.\n"
-     "  --seed S   the random seed (default fixed)\n"
-     "  --quick    fewer samples\n"},
+     "materials; closed-form transmittance, cross-tracker agreement and heavy tails for trackers; a furnace for\n"
+     "integrators. Each plugin runs with its defaults, every range at 25 % and 75 %, and each parameter alone at\n"
+     "both ends of its range and at every enum and bool value; each in a process of its own (a crash is a FAIL).\n"
+     "  --seed S          the random seed (default fixed)\n"
+     "  --quick           fewer samples\n"
+     "  --set KEY=VALUE   check one plugin at these parameter values (repeatable) instead of the sweep\n"},
     {"grid",
      "usage: murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O]\n"
      "                 [--coverage C]\n"
@@ -554,8 +557,9 @@ static int render_loaded(render_args *ra, const murk_scene *s, volatile sig_atom
     }
     murk_warn_summary();
     if (res.nonfinite)
-        murk_log(MURK_LOG_WARN, "integrator '%s' returned %llu NaN or infinite samples; they were left out of their "
-                 "pixels", s->integrator_plugin->desc->name, (unsigned long long)res.nonfinite);
+        murk_log(MURK_LOG_WARN, "integrator '%s' [%s] returned %llu NaN or infinite samples; they were left out of "
+                 "their pixels", s->integrator_plugin->desc->name, s->integrator_plugin->path,
+                 (unsigned long long)res.nonfinite);
     free(res.rgb);
     return rc;
 }
@@ -699,6 +703,51 @@ static int cmd_grid(int argc, char **argv)
     return rc ? 1 : 0;
 }
 
+/* The data folder (holding murk/examples, murk/scenes, doc/murk) of the running murk: DATADIR relative to
+ * its executable if that holds murk's examples (an install, moved or staged with --destdir), else the
+ * configured prefix's. */
+static void installed_datadir(char *out, size_t n)
+{
+    char exe[4096], dir[4096 + 64];
+    ssize_t k = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (k > 0) {
+        exe[k] = 0;
+        char *slash = strrchr(exe, '/');
+        if (slash) {
+            *slash = 0;
+            snprintf(dir, sizeof dir, "%s/%s/murk/examples", exe, MURK_DATADIR_FROM_BINDIR);
+            char real[4096];
+            if (realpath(dir, real) && strlen(real) > strlen("/murk/examples")) {
+                real[strlen(real) - strlen("/murk/examples")] = 0;
+                snprintf(out, n, "%s", real);
+                return;
+            }
+        }
+    }
+    snprintf(out, n, "%s", MURK_DATADIR);
+}
+
+/* `murk help`'s last lines: where the guide, the example plugins and the starter scenes are, for this
+ * murk (the sources' when it runs from its build tree). */
+static void print_files(void)
+{
+    if (murk_running_uninstalled()) {
+        printf("\nfiles (murk runs from its build tree: the sources at %s)\n"
+               "  docs         %s/README.md, %s/docs/plugins.md (writing plugins)\n"
+               "  examples     %s/plugins/examples (three plugins to copy, their meson.build, examples.yaml)\n"
+               "  scenes       %s/scenes\n",
+               MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT, MURK_SOURCE_ROOT);
+        return;
+    }
+    char d[4096];
+    installed_datadir(d, sizeof d);
+    printf("\nfiles\n"
+           "  docs         %s/doc/murk/README.md, %s/doc/murk/docs/plugins.md (writing plugins)\n"
+           "  examples     %s/murk/examples (three plugins to copy, their meson.build, examples.yaml)\n"
+           "  scenes       %s/murk/scenes (starter scenes)\n",
+           d, d, d, d);
+}
+
 int murk_cli_main(int argc, char **argv)
 {
     if (argc < 2)
@@ -711,6 +760,7 @@ int murk_cli_main(int argc, char **argv)
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || (!strcmp(cmd, "help") && argc == 2)) {
         fputs(murk_cli_usage_text, stdout);
+        print_files();
         return 0;
     }
     int known = 0;

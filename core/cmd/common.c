@@ -21,7 +21,7 @@ const char murk_cli_usage_text[] =
     "  murk plugins [--markdown] [--all | NAME]\n"
     "  murk compare TEST.exr REFERENCE.exr [--crop X,Y,W,H] [--json] [--diff DIFF.png [--scale S]] [--html PAGE.html]\n"
     "  murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--spp N1,N2,... | --time S1,...] [--repeat K] [-o DIR] ...\n"
-    "  murk check [--seed S] [--quick] PLUGIN...\n"
+    "  murk check [--seed S] [--quick] [--set KEY=VALUE]... PLUGIN...\n"
     "  murk grid OUT.vol [--min X,Y,Z] [--max X,Y,Z] [--res N] [--seed S] [--frequency F] [--octaves O] [--coverage C]\n"
     "  murk help [COMMAND]      (or murk COMMAND --help)\n"
     "  murk --version\n";

@@ -29,14 +29,23 @@ static char **split_list(const char *s, int *n)
     char **v = NULL;
     *n = 0;
     for (const char *p = s;;) {
-        const char *c = strchr(p, ',');
-        size_t l = c ? (size_t)(c - p) : strlen(p);
+        const char *c = p;
+        int depth = 0, quote = 0; /* a comma inside [], {} or quotes belongs to its value: {type: X, k: v} */
+        for (; *c && (*c != ',' || depth > 0 || quote); c++) {
+            if (quote)
+                quote = *c == quote ? 0 : quote;
+            else if (*c == '"' || *c == '\'')
+                quote = *c;
+            else
+                depth += (*c == '[' || *c == '{') - (*c == ']' || *c == '}');
+        }
+        size_t l = (size_t)(c - p);
         v = murk_xrealloc(v, (size_t)(*n + 1) * sizeof *v);
         v[*n] = murk_xmalloc(l + 1);
         memcpy(v[*n], p, l);
         v[*n][l] = 0;
         (*n)++;
-        if (!c)
+        if (!*c)
             break;
         p = c + 1;
     }
@@ -48,6 +57,64 @@ static void free_list(char **v, int n)
     for (int i = 0; i < n; i++)
         free(v[i]);
     free(v);
+}
+
+/* s without its leading and trailing blanks, into a new string. */
+static char *trimmed(const char *s)
+{
+    while (*s == ' ' || *s == '\t')
+        s++;
+    size_t l = strlen(s);
+    while (l && (s[l - 1] == ' ' || s[l - 1] == '\t'))
+        l--;
+    char *t = murk_xmalloc(l + 1);
+    memcpy(t, s, l);
+    t[l] = 0;
+    return t;
+}
+
+/* The --set assignments of --vary KEY's value v, into out (max of them; freed by the caller): KEY=v; or,
+ * when v is a whole plugin block {type: X, k: w, ...}, one per key with `type` first, KEY.type=X KEY.k=w,
+ * so that the swap of the type drops the previous plugin's keys and the new plugin's keys are checked
+ * against the new plugin (a block given whole would drop the scene's density, sigma_s, ...). The count,
+ * or -1 when v is a block whose items are not `key: value`. */
+static int vary_assignments(const char *key, const char *v, char **out, int max)
+{
+    char *t = trimmed(v);
+    size_t tl = strlen(t);
+    if (t[0] != '{' || tl < 2 || t[tl - 1] != '}') {
+        free(t);
+        out[0] = murk_xmalloc(strlen(key) + strlen(v) + 2);
+        sprintf(out[0], "%s=%s", key, v);
+        return 1;
+    }
+    t[tl - 1] = 0;
+    int nitems, n = 0, bad = 0;
+    char **items = split_list(t + 1, &nitems);
+    for (int pass = 0; pass < 2 && !bad; pass++) /* type, then the rest in the order given */
+        for (int i = 0; i < nitems && !bad; i++) {
+            char *colon = strchr(items[i], ':');
+            char *k = colon ? (*colon = 0, trimmed(items[i])) : NULL;
+            if (colon)
+                *colon = ':';
+            char *w = colon ? trimmed(colon + 1) : NULL;
+            bad = !k || !*k || strspn(k, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != strlen(k) ||
+                  !*w || n == max;
+            if (!bad && (pass == 0) == !strcmp(k, "type")) {
+                out[n] = murk_xmalloc(strlen(key) + strlen(k) + strlen(w) + 3);
+                sprintf(out[n++], "%s.%s=%s", key, k, w);
+            }
+            free(k);
+            free(w);
+        }
+    free_list(items, nitems);
+    free(t);
+    if (bad) {
+        while (n > 0)
+            free(out[--n]);
+        return -1;
+    }
+    return n;
 }
 
 /* Variant i's value index along --vary k (the last --vary varies fastest). */
@@ -102,10 +169,10 @@ size_t murk_bench_sets(const bench *b, int i, long seed, const char **out, char 
             out[n++] = b->ref_sets[k];
     } else {
         for (int j = 0; j < b->nvary; j++) {
-            size_t l = strlen(b->vary[j].key) + strlen(b->vary[j].vals[variant_value(b, i < 0 ? 0 : i, j)]) + 2;
-            char *s = murk_xmalloc(l);
-            snprintf(s, l, "%s=%s", b->vary[j].key, b->vary[j].vals[variant_value(b, i < 0 ? 0 : i, j)]);
-            out[n++] = store[(*nstore)++] = s;
+            int m = vary_assignments(b->vary[j].key, b->vary[j].vals[variant_value(b, i < 0 ? 0 : i, j)],
+                                     store + *nstore, MAX_BLOCK_KEYS); /* parse_vary checked it */
+            for (int q = 0; q < m; q++)
+                out[n++] = store[(*nstore)++];
         }
     }
     if (seed >= 0) {
@@ -186,7 +253,7 @@ murk_scene *murk_bench_load(const bench *b, const char *const *sets, size_t nset
 static int validate(const bench *b)
 {
     char err[2048];
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
+    const char **sets = murk_xmalloc(murk_bench_max_sets(b) * sizeof *sets);
     murk_scene *s = murk_bench_load(b, b->sets, b->nsets, err, sizeof err);
     int rc = 0;
     if (!s) {
@@ -201,13 +268,16 @@ static int validate(const bench *b)
             break;
         }
         for (int k = 0; k < b->vary[j].nvals && !rc; k++) {
-            char one[4096];
-            snprintf(one, sizeof one, "%s=%s", b->vary[j].key, b->vary[j].vals[k]);
+            char *one[MAX_BLOCK_KEYS];
             size_t n = 0;
             for (size_t q = 0; q < b->nsets; q++)
                 sets[n++] = b->sets[q];
-            sets[n++] = one;
+            int m = vary_assignments(b->vary[j].key, b->vary[j].vals[k], one, MAX_BLOCK_KEYS);
+            for (int q = 0; q < m; q++)
+                sets[n++] = one[q];
             murk_scene *t = murk_bench_load(b, sets, n, err, sizeof err);
+            for (int q = 0; q < m; q++)
+                free(one[q]);
             if (!t) {
                 fprintf(stderr, "%s\nmurk: bench: in --vary %s (value '%s'); nothing was rendered\n", err,
                         murk_cli_q(b->vary[j].arg), murk_cli_q(b->vary[j].vals[k]));
@@ -216,7 +286,7 @@ static int validate(const bench *b)
             murk_scene_free(t);
         }
     }
-    char *store[64];
+    char *store[BENCH_STORE];
     size_t nstore = 0;
     for (int i = -1; i < b->nvariants && !rc; i++) {
         if (i < 0 && !b->nref_sets)
@@ -284,6 +354,9 @@ static const char bench_usage[] =
     "usage: murk bench SCENE.yaml [--vary KEY=V1,V2,...]... [--set KEY=VALUE]... [--spp N1,N2,... | --time S1,S2,...]\n"
     "                  [--repeat K] [--reference REF.exr | --ref-spp N [--ref-set KEY=VALUE]...] [--threads N]\n"
     "                  [-o DIR] [--no-charts] [--emit-jobs JOBDIR | --assemble JOBDIR]\n"
+    "A --vary value in braces is a whole plugin block, its keys set together with the type first, so that a swap\n"
+    "carries its own keys: --vary 'media.smoke={type: decomposition, control: 0.5},{type: delta}'. Values are\n"
+    "split at commas outside brackets, braces and quotes.\n"
     "SIGINT/SIGTERM/SIGHUP abandon the running render; the finished renders' rows go to DIR/bench-interrupted.csv\n"
     "(never bench.csv) and murk exits with 128 + the signal.\n";
 
@@ -402,11 +475,20 @@ static int bench_defaults(bench *b, char *outbuf, size_t outlen)
             rc = 2;
         }
         b->nvariants *= b->vary[j].nvals;
-        for (int k = 0; k < b->vary[j].nvals; k++)
-            if (!*b->vary[j].vals[k]) {
-                fprintf(stderr, "murk: --vary %s has an empty value\n", murk_cli_q(b->vary[j].arg));
+        for (int k = 0; k < b->vary[j].nvals && !rc; k++) {
+            char *one[MAX_BLOCK_KEYS];
+            int m = *b->vary[j].vals[k] ? vary_assignments(b->vary[j].key, b->vary[j].vals[k], one, MAX_BLOCK_KEYS) : 0;
+            if (m <= 0) {
+                if (m == 0)
+                    fprintf(stderr, "murk: --vary %s has an empty value\n", murk_cli_q(b->vary[j].arg));
+                else
+                    fprintf(stderr, "murk: --vary %s: '%s' is not a block {key: value, ...} of at most %d keys\n",
+                            murk_cli_q(b->vary[j].arg), murk_cli_q(b->vary[j].vals[k]), MAX_BLOCK_KEYS);
                 rc = 2;
             }
+            while (m > 0)
+                free(one[--m]);
+        }
         if (rc)
             return rc;
     }

@@ -38,7 +38,15 @@ typedef struct bench {
     void *user;
 } bench;
 
-enum { REF_CHUNKS = 4, MAX_VARY = 32 }; /* MAX_VARY: the --vary strings of one render fit in store[64] */
+/* MAX_VARY --vary of at most MAX_BLOCK_KEYS assignments each (a whole plugin block, KEY={type: X, k: v}):
+ * the strings murk_bench_sets makes for one render fit in BENCH_STORE. */
+enum { REF_CHUNKS = 4, MAX_VARY = 32, MAX_BLOCK_KEYS = 16, BENCH_STORE = MAX_VARY * MAX_BLOCK_KEYS + 1 };
+
+/* The most --set strings murk_bench_sets may give for one render. */
+static inline size_t murk_bench_max_sets(const bench *b)
+{
+    return b->nsets + b->nref_sets + (size_t)b->nvary * MAX_BLOCK_KEYS + 2;
+}
 
 /* A signal asked the bench to stop. */
 static inline int murk_bench_stopped(const bench *b) { return b->stop && *b->stop; }

@@ -122,8 +122,8 @@ static void emit_job(const bench *b, FILE *jobs, const char *murk, const char *s
 static int jobs_txt(const bench *b, FILE *f, const char *murk, const char *scene)
 {
     char out[8192];
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
+    const char **sets = murk_xmalloc(murk_bench_max_sets(b) * sizeof *sets);
+    char *store[BENCH_STORE];
     size_t nstore = 0;
     int njobs = 0;
     for (int c = 0; c < REF_CHUNKS && !b->reference; c++) {

@@ -61,8 +61,8 @@ int murk_bench_read_exr(const char *path, int w, int h, float **out)
 int murk_bench_reference(const bench *b, reference *r)
 {
     char err[2048], dir[3072];
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
+    const char **sets = murk_xmalloc(murk_bench_max_sets(b) * sizeof *sets);
+    char *store[BENCH_STORE];
     size_t nstore = 0, n = murk_bench_sets(b, -1, -1, sets, store, &nstore);
     /* the scene file and every file it loads (meshes, grids, textures), as a checkpoint hashes them */
     murk_scene *hs = murk_bench_load(b, sets, n, err, sizeof err);

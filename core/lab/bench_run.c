@@ -444,8 +444,8 @@ static int render_one(run *u, int v, int bi, int k, const char *label, const cha
 static int sweep(run *u)
 {
     const bench *b = u->b;
-    const char **sets = murk_xmalloc((b->nsets + (size_t)b->nvary + b->nref_sets + 2) * sizeof *sets);
-    char *store[64];
+    const char **sets = murk_xmalloc(murk_bench_max_sets(b) * sizeof *sets);
+    char *store[BENCH_STORE];
     size_t nstore = 0;
     double total_w = 0, done_w = 0;
     for (int i = 0; i < b->nbudgets; i++)

@@ -4,6 +4,7 @@
 #include "media/media.h"
 #include "render/envmap.h"
 #include "scene/texture.h"
+#include "util/runtime.h"
 #include "util/util.h"
 
 #include <stdlib.h>
@@ -22,6 +23,7 @@ MURK_API void murk_scene_free(murk_scene *s)
 {
     if (!s)
         return;
+    murk_warn_forget(s);
     if (s->rtc)
         rtcReleaseScene(s->rtc);
     if (s->device)

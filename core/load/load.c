@@ -14,6 +14,7 @@
 #include "scene/obj.h"
 #include "scene/params.h"
 #include "util/limit.h"
+#include "util/runtime.h"
 #include "util/util.h"
 #include "yaml/yread.h"
 
@@ -711,6 +712,29 @@ MURK_API int murk_scene_check_unused(const murk_scene *s, char *err, size_t errl
     return s->doc.root ? check_unused(s->doc.root, 0, err, errlen) : 0;
 }
 
+/* Each instance's plugin and file, for the render's warnings (murk_warn_name): an integrator's message
+ * about `material 'red'` then says which plugin and which .so it is. */
+static void name_instances(const murk_scene *s)
+{
+    char who[300], what[5000];
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        snprintf(who, sizeof who, "material '%s'", s->materials[i].name);
+        snprintf(what, sizeof what, "plugin %s, %s", s->materials[i].plugin->desc->name, s->materials[i].plugin->path);
+        murk_warn_name(s, who, what);
+    }
+    for (size_t i = 0; i < s->nmedia; i++) {
+        const murk_named_medium *m = &s->media[i];
+        snprintf(who, sizeof who, "medium '%s'", m->name);
+        int k = snprintf(what, sizeof what, "tracker %s, %s", m->plugin->desc->name, m->plugin->path);
+        if (m->tr_plugin && k > 0 && (size_t)k < sizeof what)
+            snprintf(what + k, sizeof what - (size_t)k, "; transmittance %s, %s", m->tr_plugin->desc->name,
+                     m->tr_plugin->path);
+        murk_warn_name(s, who, what);
+    }
+    snprintf(who, sizeof who, "integrator '%s'", s->integrator_plugin->desc->name);
+    murk_warn_name(s, who, s->integrator_plugin->path);
+}
+
 /* The scene of doc (read, or -1 with err already set), with the --set overrides. */
 static murk_scene *load_scene(murk_scene *s, int read, const char *const *sets, size_t nsets, char *err,
                               size_t errlen)
@@ -729,6 +753,7 @@ static murk_scene *load_scene(murk_scene *s, int read, const char *const *sets, 
         murk_scene_free(s);
         return NULL;
     }
+    name_instances(s);
     return s;
 }
 

@@ -56,7 +56,8 @@ static void add_dir(murk_registry *r, const char *d, size_t len)
     r->dirs[r->ndirs++] = s;
 }
 
-static int running_uninstalled(void)
+/* 1 if the running program lives in murk's build tree (plugin_loader.h). */
+int murk_running_uninstalled(void)
 {
     char exe[PATH_MAX], root[PATH_MAX];
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -100,7 +101,7 @@ void murk_registry_init(murk_registry *r)
             p = c + 1;
         }
     }
-    if (running_uninstalled()) {
+    if (murk_running_uninstalled()) {
         add_dir(r, MURK_BUILD_PLUGINDIR, strlen(MURK_BUILD_PLUGINDIR));
         return;
     }

@@ -25,6 +25,9 @@ typedef struct murk_registry {
  * (a moved or DESTDIR-staged install finds its own), then the configured one. Never the current folder
  * unless a MURK_PLUGIN_PATH entry names it. */
 void murk_registry_init(murk_registry *r);
+/* 1 if the running program is in murk's build tree (then built-in plugins are build/plugins, and the
+ * docs, examples and scenes are the sources'), 0 if it is installed. */
+int murk_running_uninstalled(void);
 void murk_registry_free(murk_registry *r); /* dlcloses everything it opened */
 /* Finds NAME.so on the search path, opens and validates it (cached: a name is loaded once).
  * kind 0 accepts any kind. Returns NULL with err = one line naming the file and the cause. */

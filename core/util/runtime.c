@@ -29,14 +29,61 @@ static pthread_mutex_t warn_lock = PTHREAD_MUTEX_INITIALIZER;
 static struct { char *msg; unsigned long count; } warned[128];
 static int nwarned;
 
+static struct { const void *owner; char *who, *what; } named[256];
+static int nnamed;
+
+void murk_warn_name(const void *owner, const char *who, const char *what)
+{
+    pthread_mutex_lock(&warn_lock);
+    if (nnamed < (int)(sizeof named / sizeof named[0])) {
+        named[nnamed].owner = owner;
+        named[nnamed].who = murk_strdup(who);
+        named[nnamed].what = murk_strdup(what);
+        nnamed++;
+    }
+    pthread_mutex_unlock(&warn_lock);
+}
+
+void murk_warn_forget(const void *owner)
+{
+    pthread_mutex_lock(&warn_lock);
+    int k = 0;
+    for (int i = 0; i < nnamed; i++) {
+        if (named[i].owner == owner) {
+            free(named[i].who);
+            free(named[i].what);
+        } else {
+            named[k++] = named[i];
+        }
+    }
+    nnamed = k;
+    pthread_mutex_unlock(&warn_lock);
+}
+
+/* buf with " [what]" after the first instance it names (the latest naming of it), in place; under the lock. */
+static void annotate(char *buf, size_t size)
+{
+    for (int i = nnamed - 1; i >= 0; i--) {
+        char *at = strstr(buf, named[i].who);
+        if (!at)
+            continue;
+        at += strlen(named[i].who);
+        char rest[512];
+        snprintf(rest, sizeof rest, "%s", at);
+        snprintf(at, size - (size_t)(at - buf), " [%s]%s", named[i].what, rest);
+        return;
+    }
+}
+
 void murk_warn_once(const char *fmt, ...)
 {
-    char buf[512];
+    char buf[1024];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    vsnprintf(buf, 512, fmt, ap);
     va_end(ap);
     pthread_mutex_lock(&warn_lock);
+    annotate(buf, sizeof buf);
     int i = 0;
     while (i < nwarned && strcmp(warned[i].msg, buf) != 0)
         i++;

@@ -17,6 +17,13 @@ void murk_set_quiet(int quiet);
 void murk_warn_once(const char *fmt, ...) MURK_PRINTF(1, 2);
 /* Prints how often each once-only warning repeated, and forgets them. */
 void murk_warn_summary(void);
+/* Names a scene's instance for the warnings: a once-only warning whose text holds `who` ("material
+ * 'red'", "medium 'smoke'", "integrator 'path'") gets " [what]" after it ("plugin diffuse,
+ * /usr/lib/murk/plugins/diffuse.so"), so that a message an integrator writes about the scene's instance
+ * also names the plugin and the file behind it. owner: the scene (the last one named wins). */
+void murk_warn_name(const void *owner, const char *who, const char *what);
+/* Forgets the names an owner gave (murk_scene_free). */
+void murk_warn_forget(const void *owner);
 
 /* The calling thread's tally: the rays it traced and its cost counters, one block per counter slot (a
  * medium's slot is its index in the scene; the last slot is shared by the media beyond it). Plain

@@ -12,7 +12,7 @@
 enum { P_CHANNEL, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
-    [P_CHANNEL] = {"channel", MURK_PARAM_ENUM, 0, {0, 0, 0}, "hero", "hero|red|green|blue", 0, 0,
+    [P_CHANNEL] = {"channel", MURK_PARAM_ENUM, MURK_PARAM_NO_SWEEP, {0, 0, 0}, "hero", "hero|red|green|blue", 0, 0,
                    "the channel a path tracks: hero, the path's hero channel (drawn uniformly per path by the "
                    "integrator; it alone is credited, with 3x its estimate); red, green or blue, that channel on "
                    "every path, credited 1x: one pass of the reference report's three-pass baseline, whose image "

@@ -9,7 +9,7 @@
 enum { P_CONTROL, P_COUNT };
 
 static const murk_param params[P_COUNT] = {
-    [P_CONTROL] = {"control", MURK_PARAM_FLOAT, 0, {1, 0, 0}, NULL, NULL, 0, 10,
+    [P_CONTROL] = {"control", MURK_PARAM_FLOAT, MURK_PARAM_NO_SWEEP, {1, 0, 0}, NULL, NULL, 0, 10,
                    "the control density of a majorant cell as a multiple of the cell's minimum density (the "
                    "minorant grid); its optical depth is taken in closed form, exp(-c sigma_t L) per cell and "
                    "channel, and only the residual density - c is ratio-tracked, against the residual majorant "

@@ -113,6 +113,11 @@ typedef enum murk_param_type {
  * roughness^2): a scene gives one or the other. The loader refuses both, located at the second key;
  * murk check gives each in turn. A host that predates the flag ignores it (create() should refuse both). */
 #define MURK_PARAM_ALT_SCALE 4u
+/* Values away from the default exist for study, not for use: where the method's assumption fails
+ * (residual_ratio's control far above the density) or one pass of several (naive_spectral's fixed
+ * channel). murk check's sweep keeps the parameter at its default; `murk check --set` still takes any
+ * value. A host that predates the flag ignores it. */
+#define MURK_PARAM_NO_SWEEP 8u
 
 typedef struct murk_param {
     const char *name;
