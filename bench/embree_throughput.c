@@ -40,7 +40,8 @@
  * so the replay runs more rays per second than the raw side, and murk / raw flatters murk by that factor
  * (bench/throughput.md has it). murk / replay is the like-for-like ratio (the same Embree work on both
  * sides); it is also the share of murk's time spent inside Embree. Both are printed; the issue's goal
- * (70 %) was stated against raw. bench/throughput.md has the figures and where the rest of murk's time
+ * (70 %) was stated against raw. On a scene the bare tracer supports, murk / bare (murk's rays per second
+ * over the `bare` rung's, per round) is the yardstick of murk's layers: what the plugin design costs. bench/throughput.md has the figures and where the rest of murk's time
  * goes.
  *
  * Then the media figure, on scenes/cornell_smoke.yaml's cloud with the `delta` tracker (grey extinction):
@@ -650,8 +651,9 @@ int main(int argc, char **argv)
     for (int j = 0; bare && j < BARE_RUNGS; j++)
         printf("  %s/raw", bare_rung_name[j]);
     printf("\n");
-    double *ratio = murk_xmalloc((2 + BARE_RUNGS) * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds,
-           *bratio = rratio + rounds; /* bratio[j * rounds + k] */
+    double *ratio = murk_xmalloc((3 + BARE_RUNGS) * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds,
+           *bratio = rratio + rounds, /* bratio[j * rounds + k] */
+        *lratio = bratio + BARE_RUNGS * (size_t)rounds; /* murk / bare (sobol): what murk's layers leave */
     double bmean[BARE_RUNGS] = {0}, mmean = 0.0;
     for (int k = 0; k < rounds; k++) {
         uint64_t nraw;
@@ -673,6 +675,7 @@ int main(int argc, char **argv)
         rratio[k] = mr / rep;
         printf("%5d  %11.2f  %14.2f  %12.2f  %6.1f %%  %9.1f %%", k + 1, raw / 1e6, rep / 1e6, mr / 1e6, 100.0 * ratio[k],
                100.0 * rratio[k]);
+        lratio[k] = bare ? mr / br[BARE] : 0.0; /* the bare tracer with the scene's sampler */
         for (int j = 0; bare && j < BARE_RUNGS; j++) {
             bratio[j * rounds + k] = br[j] / raw;
             printf("  %*.1f %%", (int)strlen(bare_rung_name[j]) + 2, 100.0 * bratio[j * rounds + k]);
@@ -684,6 +687,8 @@ int main(int argc, char **argv)
     if (bare) {
         for (int j = 0; j < BARE_RUNGS; j++)
             printf("%s / raw Embree: %s\n", bare_rung_name[j], median_spread(bratio + j * rounds, rounds));
+        printf("murk / bare (the layers' ratio: murk's rays per CPU second over the bare tracer's with the same "
+               "sampler, per round): %s\n", median_spread(lratio, rounds));
         printf("image means (all channels, over the rounds): murk %.5f", mmean);
         for (int j = 0; j < BARE_RUNGS; j++)
             printf(", %s %.5f", bare_rung_name[j], bmean[j]);
