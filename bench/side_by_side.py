@@ -29,6 +29,7 @@ different mean is rendering something else.
 """
 import argparse
 import os
+import re
 import resource
 import statistics
 import subprocess
@@ -60,13 +61,24 @@ def run(cmd, cwd, log):
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+def pbrt_seeded(path, seed):
+    """pbrt-v4's Sampler "integer seed" overrides its --seed option: a copy of the scene beside it with the
+    seed set (so that every round's render has errors of its own)."""
+    text = open(path).read()
+    if not re.search(r'"integer seed"', text):
+        return path
+    copy = path[:-5] + ".seed%d.pbrt" % seed
+    open(copy, "w").write(re.sub(r'"integer seed"\s*\[\s*-?\d+\s*\]', '"integer seed" [ %d ]' % seed, text))
+    return copy
+
+
 def command(a, kind, exe, scene, spp, seed, out):
     """The command line rendering scene (a dict of the renderers' files) with renderer `kind`."""
     if kind == "tungsten":
         return [exe, "-t", str(a.threads), "-s", str(seed), "--spp", str(spp), "-e", out, scene["tungsten"]]
     if kind == "pbrt":
         return [exe, "--nthreads", str(a.threads), "--quiet", "--seed", str(seed), "--spp", str(spp), "--outfile", out,
-                scene["pbrt"]]
+                pbrt_seeded(scene["pbrt"], seed)]
     cmd = [exe, "render", scene["murk"], "-o", out, "--quiet", "--threads", str(a.threads), "--spp", str(spp),
            "--set", "render.seed=%d" % seed]
     for kv in a.set:
