@@ -228,10 +228,14 @@ static double murk_side(murk_scene *s, double seconds, int *spp, double *mean)
  * camera ray (murk_camera_sample), rtcIntersect1 / rtcOccluded1 called here, the hit point o + t d and the
  * triangle's stored normal, the albedo read once per shape before timing (the material's eval at normal
  * incidence, times pi), NEE by area with the power heuristic against cosine sampling, emission weighted
- * the same way, murk's Russian roulette (after 3 events, q = max(beta) clamped to [0.05, 1]), max depth
+ * the same way, murk's Russian roulette (after 3 events, q = max(beta) / 0.3 clamped to [0.05, 1]: the default
+ * rr_threshold), max depth
  * 64. No plugin calls, no murk_hit, no NaN checks, no boundaries, no media. Its numbers come from murk's
  * sampler: `bare` with the scene's (sobol), `bare-pcg` with independent numbers. Its image agrees with
  * murk's in expectation (the mean of both renders is printed). Rays counted per Embree call, as murk's. */
+/* the path integrators' default rr_threshold (pathtracer.c), so that the bare paths are as long as murk's */
+#define BARE_RR_THRESHOLD 0.3f
+
 typedef struct bare_pt {
     const murk_scene *s;
     murk_rgb *albedo; /* per shape */
@@ -439,7 +443,7 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
         prev_p = p;
         prev_cam = 0;
         if (depth + 1 > 3) {
-            float qq = murk_maxf(0.05f, murk_minf(1.0f, murk_maxf(beta.c[0], murk_maxf(beta.c[1], beta.c[2]))));
+            float qq = murk_maxf(0.05f, murk_minf(1.0f, murk_maxf(beta.c[0], murk_maxf(beta.c[1], beta.c[2])) / BARE_RR_THRESHOLD));
             murk_sample_seek(rng, 2u + (uint32_t)depth * 5u + 4u);
             if (murk_sample_1d(rng) >= qq)
                 break;
