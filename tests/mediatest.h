@@ -1,11 +1,12 @@
 /* mediatest.h — the kit test_media.c and test_transmittance.c share: scenes of several media with
  * common keys, the density grids and rays with closed-form optical depths (ramp, checker) or a
- * quadrature reference (sinusoid), per-channel statistics over N estimates, and the 4-se check with
- * its 3% resolution demand and its printed line. */
+ * quadrature reference (sinusoid), per-channel statistics over N estimates, and the z-check (stat.h)
+ * with its printed line. */
 #ifndef MURK_MEDIATEST_H
 #define MURK_MEDIATEST_H
 
 #include "testutil.h"
+#include "stat.h"
 
 #include "media/density.h"
 #include "render/host.h"
@@ -18,7 +19,8 @@
 typedef struct mt_spec {
     const char *label; /* the medium's name in the scene */
     const char *keys;  /* its own keys, e.g. "type: decomposition, control: 0.5" */
-    int weighted;      /* 1: a bound fails on purpose (weighted collisions): no resolution demanded */
+    double wmax;       /* > 0: a bound fails on purpose (weighted, heavy-tailed): the weights' stated maximum,
+                        * for mt_check_bounded; 0: the z-test */
 } mt_spec;
 
 /* Writes tmp_dir()/file, a scene with one medium per spec, `LABEL: { PREFIX KEYS, COMMON }` (prefix
@@ -75,7 +77,8 @@ double mt_quadrature(const murk_medium *m, const murk_ray *ray);
 /* Per-channel sums of x - k over n samples, k the first sample (no cancellation when all are equal). */
 typedef struct mt_acc {
     long n;
-    double k[3], s[3], s2[3];
+    double k[3], s[3], s2[3], s3[3], s4[3]; /* sums of powers of x - k */
+    double amax[3];                         /* the largest |x| */
 } mt_acc;
 
 void mt_acc_add(mt_acc *a, const double x[3]);
@@ -92,11 +95,25 @@ int mt_call(const murk_medium *m, const murk_ray *ray, murk_rng *rng, murk_rgb *
 /* Monotonic clock, seconds. */
 double mt_seconds(void);
 
-/* Checks a per-channel figure against its expectation: |mean - expect| <= 4 se + rel |expect| + 1e-7
- * (float rounding) in every channel. With power it also asserts the figure's resolution: in its
- * best-measured channel a 3% error must amount to at least 5 se, so that it would fail the 4 se bound
- * with probability >= 84%. Prints one line: head, then mean +- se (expected, z) per channel, then
- * "3%=" that resolution in se, then tail. Returns the number of failed demands (0 to 2). */
-int mt_check(const char *head, const mt_acc *a, const double expect[3], double rel, int power, const char *tail);
+/* Checks a per-channel figure against its expectation: stat_z_ok in every channel, |mean - expect| <=
+ * STAT_Z se + rel |expect| + 1e-7 (float rounding). Prints one line: head, then mean +- se (expected, z)
+ * per channel, then tail. Returns 1 if a channel failed. */
+int mt_check(const char *head, const mt_acc *a, const double expect[3], double rel, const char *tail);
+/* A figure whose samples may be heavy-tailed (weighted collisions where a bound fails on purpose), judged
+ * by a bound that holds for any distribution on [-W, W] instead of the normal approximation: the
+ * empirical Bernstein bound (Maurer and Pontil 2009, theorem 4, both sides),
+ *   |mean - expect| <= sqrt(2 V L / n) + 7 R L / (3 (n - 1)),  L = ln(4 / alpha), R = 2 W,
+ * V the sample variance, alpha = stat_tail2(STAT_Z) (counted as one decision per channel). W is the
+ * weights' maximum: wmax, derived or stated by the caller, or the largest |sample| if that is larger (a
+ * stated maximum is not a proof; the figure never fails for exceeding it, it widens the bound). Prints
+ * one line like mt_check's with the bound in place of the se and the largest |sample|, and returns 1 if a
+ * channel failed. */
+int mt_check_bounded(const char *head, const mt_acc *a, const double expect[3], double wmax, const char *tail);
+/* The same bound for must-fail cases: the largest over the channels of STAT_Z |mean - expect| / bound
+ * (above STAT_Z exactly when mt_check_bounded fails the channel). */
+double mt_zmax_bounded(const mt_acc *a, const double expect[3], double wmax);
+/* The same test, neither printed nor counted (for must-fail cases): the largest over the channels of
+ * (|mean - expect| - slack) / se; the figure fails mt_check exactly when it exceeds STAT_Z. */
+double mt_zmax(const mt_acc *a, const double expect[3], double rel);
 
 #endif

@@ -2,6 +2,7 @@
  * estimator's and tracker's collisions against its lookups, zero lookups without media, and per-thread
  * counts that merge to the same totals on any thread count. */
 #include "mediatest.h"
+#include "stat.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -12,8 +13,10 @@
  * tentative collisions are a Poisson process of rate f mu, thinned with probability 1/f into the real
  * ones, and the flight stops at the first real one or at L. So the mean number of tentative collisions
  * per flight is  f mu E[min(L, Exp(mu))] = f (1 - exp(-mu L))  (f mu L when mu L is small), and every
- * flight scatters with probability 1 - exp(-mu L). Checked within 4 standard errors of the sample
- * (the per-flight counts' own variance), on 200 000 flights; the lookups equal the collisions. */
+ * flight scatters with probability 1 - exp(-mu L). Checked within STAT_Z standard errors of the sample
+ * (the per-flight counts' own variance; stat.h), on 200 000 flights; the lookups equal the collisions.
+ * Must-fail: the counts against those of a majorant 3 % larger, the scattered fraction against a medium
+ * 5 % denser. */
 static void slab_closed_form(void **state)
 {
     (void)state;
@@ -42,12 +45,16 @@ static void slab_closed_form(void **state)
     double mean = sum / n, var = (sum2 - sum * sum / n) / (n - 1), se = sqrt(var / n);
     double expect = f * (1.0 - exp(-mu * L));
     printf("slab: %.5f tentative collisions per flight (closed form %.5f, se %.5f)\n", mean, expect, se);
-    assert_true(fabs(mean - expect) < 4.0 * se);
+    assert_true(stat_z_ok(mean, se, expect, 0.0));
+    double zf = fabs(mean - 1.03 * expect) / se;
+    assert_true(stat_must_fail("tentative collisions against a majorant 3% larger", zf > STAT_Z, zf));
     const murk_counters *c = &murk_thread_counters[0];
     assert_true(c->lookups == c->collisions);
     assert_true(c->scatters == scattered);
     double ps = 1.0 - exp(-mu * L), sp = sqrt(ps * (1.0 - ps) / n);
-    assert_true(fabs((double)scattered / n - ps) < 4.0 * sp);
+    assert_true(stat_z_ok((double)scattered / n, sp, ps, 0.0));
+    double pd = 1.0 - exp(-1.05 * mu * L), zd = fabs((double)scattered / n - pd) / sp;
+    assert_true(stat_must_fail("scattered fraction against a medium 5% denser", zd > STAT_Z, zd));
     assert_true(c->cells >= (uint64_t)n); /* every flight enters the constant field's one cell */
     murk_scene_free(s);
 }
@@ -134,7 +141,9 @@ static void collisions_match_lookups(void **state)
                 }
                 double mean = sum / n, se = sqrt(fmax(0.0, (sum2 - sum * sum / n) / (n - 1)) / n);
                 printf("  power_series: %.6f points per estimate, E max(K, k0 = %d) = %.6f\n", mean, k0, expect);
-                assert_true(fabs(mean - expect) <= 4.0 * se + 1e-9 * expect);
+                assert_true(stat_z_ok(mean, se, expect, 1e-9 * expect));
+                double zp = (fabs(mean - (expect + 0.01)) - 1e-9 * expect) / se;
+                assert_true(stat_must_fail("power_series points against 0.01 more per estimate", zp > STAT_Z, zp));
             }
         }
     }
@@ -204,7 +213,7 @@ static void per_medium_any_threads(void **state)
     assert_true(r1.rays == r3.rays);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(slab_closed_form),
@@ -212,5 +221,5 @@ int main(void)
         cmocka_unit_test(no_media_no_lookups),
         cmocka_unit_test(per_medium_any_threads),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

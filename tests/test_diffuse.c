@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "bsdftest.h"
+#include "stat.h"
 
 #define PLUGIN "plugins/diffuse.so"
 #define DEG (3.14159265358979323846 / 180.0)
@@ -20,7 +21,7 @@ static void test_schema(void **state)
     bt_destroy(m);
 }
 
-/* sample() against pdf() over the whole sphere (cells uniform in cos theta around +z) */
+/* sample() against pdf() over the whole sphere (cells uniform in cos theta around +z): p >= STAT_P */
 static void test_chi2(void **state)
 {
     (void)state;
@@ -32,15 +33,16 @@ static void test_chi2(void **state)
         char label[48];
         snprintf(label, sizeof label, "diffuse theta=%.0f", ds[i]);
         bt_chi2_result r;
-        bt_chi2(label, m, NULL, NULL, bt_dir(ds[i] * DEG, 1.0), 1000000L, 31u + (uint64_t)i, &g, &r);
-        assert_true(r.p > 0.01);
+        bt_chi2(label, m, NULL, NULL, bt_dir(ds[i] * DEG, 1.0), stat_n(500000), 31u + (uint64_t)i, &g, &r);
+        assert_true(stat_chi2_ok(r.p));
         assert_int_equal(r.mismatch, 0);
         assert_true(fabs(r.pdf_integral - 1.0) <= 3.0 * r.pdf_err + 1e-6);
     }
     bt_destroy(m);
 }
 
-/* The harness rejects a slightly wrong pdf: (n + 1) / (2 pi) cos^n with n = 1.05 instead of 1. */
+/* The must-fail case: the harness rejects a slightly wrong pdf, (n + 1) / (2 pi) cos^n with n = 1.05
+ * instead of 1. */
 static double cos_pow_pdf(void *ctx, murk_vec3 wo, murk_vec3 wi)
 {
     (void)ctx;
@@ -54,8 +56,8 @@ static void test_chi2_teeth(void **state)
     (void)state;
     bt_mat *m = bt_create(PLUGIN, NULL, 0);
     bt_grid g = {20, 40, {0, 0, 1}, 1.0};
-    double p = bt_chi2("TEETH diffuse vs cos^1.05", m, cos_pow_pdf, NULL, bt_dir(30.0 * DEG, 0.0), 1000000L, 5u, &g, NULL);
-    assert_true(p < 0.01);
+    double p = bt_chi2("diffuse vs cos^1.05", m, cos_pow_pdf, NULL, bt_dir(30.0 * DEG, 0.0), stat_n(1000000), 5u, &g, NULL);
+    assert_true(stat_must_fail_chi2("diffuse's samples against cos^1.05", p));
     bt_destroy(m);
 }
 
@@ -114,7 +116,7 @@ static void test_furnace(void **state)
     bt_destroy(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_schema),
@@ -125,5 +127,5 @@ int main(void)
     };
     if (getenv("BT_FILTER"))
         cmocka_set_test_filter(getenv("BT_FILTER"));
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

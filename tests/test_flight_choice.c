@@ -27,7 +27,8 @@
  *                   Y = 1 - exp(-sigma_t D(T)) (1 - exp(-sigma_t D(tmax)) if the flight passes) is
  *                   min(V, Ymax) with V uniform: mean Ymax - Ymax^2 / 2 and P(Y < c) = c. Per tracker,
  *                   medium and ray, 128 pixels (independent scrambles) x 1024 samples, with sobol and
- *                   with independent numbers: those five statistics within 5 se of the closed form, the
+ *                   with independent numbers: those five statistics within STAT_Z se of the closed form (a
+ *                   t with 127 degrees of freedom: counted with its tail, stat_tail2_t), the
  *                   se from the spread of the 128 pixel means (the samples within a pixel are not
  *                   independent), at least one sample's worth (1 / 131072: where the first coordinate
  *                   alone decides, the pixel counts are exact and the spread is 0). Stratification
@@ -39,9 +40,11 @@
  *                   (before decomposition carried its first number over cells, its slot drew only the
  *                   first residual distance in the cloud's first non-empty cell: |z| < 1.4); in
  *                   spectral_mis's closed form, closed_form: true 429-470 on the plateau. Every other
- *                   figure stayed within |z| 2.4. */
+ *                   figure stayed within |z| 2.4. The must-fail cases run that mutant on the tracker's
+ *                   own samples: each flight's distance scaled by 0.99 (sobol), per tracker and medium. */
 #include "testutil.h"
 #include "mediatest.h"
+#include "stat.h"
 
 #include "murk/math.h"
 #include "murk/tracking.h"
@@ -163,7 +166,6 @@ static void test_first_choice(void **state)
 
 #define NBINS 8192 /* the optical depth's quadrature bins along a ray */
 #define NSTATS 5
-#define ZMAX 5.0
 
 /* D(t) from mt_depths' bin edges over [tmin, tmax], linear within a bin. */
 static double depth_at(const double *D, const murk_ray *ray, double t)
@@ -186,17 +188,19 @@ static const char *const STAT_NAMES[NSTATS] = {"mean", "<1/16", "<1/8", "<1/4", 
 /* z of each statistic over npix pixels x 2^k samples of the flight at the path tracer's first flight
  * slot, against the closed form: the mean over all samples, its standard error from the spread of the
  * npix pixel means (independent scrambles and streams; the samples within a pixel are not
- * independent). *se_mean: the mean's standard error. */
+ * independent). *se_mean: the mean's standard error. zm: the same statistics of a mutant tracker whose
+ * first flights are SHORT shorter (the flight's t from the same samples, scaled towards tmin). */
+#define SHORT 0.01
 static void flight_stats(const murk_medium *m, const murk_ray *ray, const double *D, double sigma_t, uint32_t sampler,
-                         uint64_t seed, int npix, int k, double z[NSTATS], double *se_mean)
+                         uint64_t seed, int npix, int k, double z[NSTATS], double zm[NSTATS], double *se_mean)
 {
     double tmax = sigma_t * D[NBINS], ymax = -expm1(-tmax), expect[NSTATS] = {ymax - 0.5 * ymax * ymax};
     for (int j = 1; j < NSTATS; j++)
         expect[j] = CUTS[j - 1];
-    double s[NSTATS] = {0}, s2[NSTATS] = {0};
+    double s[2][NSTATS] = {{0}}, s2[2][NSTATS] = {{0}};
     int n = 1 << k;
     for (int p = 0; p < npix; p++) {
-        double acc[NSTATS] = {0};
+        double acc[2][NSTATS] = {{0}};
         for (int i = 0; i < n; i++) {
             murk_rng r;
             murk_sampler_start(&r, sampler, seed, (uint64_t)p * 7919u + 13u, (uint32_t)i);
@@ -205,23 +209,28 @@ static void flight_stats(const murk_medium *m, const murk_ray *ray, const double
             murk_medium_event ev;
             m->vt->sample(m->self, ray, &ctx, &r, &ev);
             assert_true(isfinite(ev.t));
-            double y = ev.scattered ? -expm1(-sigma_t * depth_at(D, ray, ev.t)) : ymax;
-            acc[0] += y;
-            for (int j = 1; j < NSTATS; j++)
-                acc[j] += y < CUTS[j - 1];
+            for (int mut = 0; mut < 2; mut++) {
+                double t = mut ? ray->tmin + (1.0 - SHORT) * (ev.t - ray->tmin) : ev.t;
+                double y = ev.scattered ? -expm1(-sigma_t * depth_at(D, ray, t)) : ymax;
+                acc[mut][0] += y;
+                for (int j = 1; j < NSTATS; j++)
+                    acc[mut][j] += y < CUTS[j - 1];
+            }
         }
+        for (int mut = 0; mut < 2; mut++)
+            for (int j = 0; j < NSTATS; j++) {
+                double d = acc[mut][j] / n - expect[j];
+                s[mut][j] += d;
+                s2[mut][j] += d * d;
+            }
+    }
+    for (int mut = 0; mut < 2; mut++)
         for (int j = 0; j < NSTATS; j++) {
-            double d = acc[j] / n - expect[j];
-            s[j] += d;
-            s2[j] += d * d;
+            double dm = s[mut][j] / npix, se = sqrt(fmax(0.0, (s2[mut][j] - npix * dm * dm) / (npix - 1.0)) / npix);
+            (mut ? zm : z)[j] = dm / fmax(se, 1.0 / ((double)npix * n));
+            if (j == 0 && !mut)
+                *se_mean = se;
         }
-    }
-    for (int j = 0; j < NSTATS; j++) {
-        double dm = s[j] / npix, se = sqrt(fmax(0.0, (s2[j] - npix * dm * dm) / (npix - 1.0)) / npix);
-        z[j] = dm / fmax(se, 1.0 / ((double)npix * n));
-        if (j == 0)
-            *se_mean = se;
-    }
 }
 
 /* A dense heterogeneous grid, 0.6 .. 1.4 on [0, 1]^3: every majorant cell has a control for
@@ -241,6 +250,7 @@ static float plateau_f(int x, int y, int z, float cx, float cy, float cz)
 }
 
 #define NCONFIGS (NTRACKERS + 1)
+#define NPIX (int)stat_n_min(128, 16)
 
 static void test_first_distance(void **state)
 {
@@ -283,7 +293,7 @@ static void test_first_distance(void **state)
         ms[i] = (mt_spec){TRACKERS[i], keys[i], 0};
     }
     ms[NTRACKERS] = (mt_spec){"spectral_mis_cf", "type: spectral_mis, closed_form: true", 0};
-    double *D = malloc((NBINS + 1) * sizeof *D);
+    double *D = malloc((NBINS + 1) * sizeof *D), zshort[NCONFIGS] = {0};
     assert_non_null(D);
     int nbad = 0;
     for (size_t md = 0; md < sizeof media / sizeof media[0]; md++) {
@@ -296,14 +306,17 @@ static void test_first_distance(void **state)
                 printf(" %s", STAT_NAMES[j]);
             printf(" (sobol | independent)\n");
             for (int i = 0; i < NCONFIGS; i++) {
-                double z[2][NSTATS], se[2];
+                double z[2][NSTATS], zm[2][NSTATS], se[2];
                 int bad = 0;
                 for (int smp = 0; smp < 2; smp++) {
                     flight_stats(&s->media[i].m, ray, D, media[md].sigma_t,
-                                 smp ? MURK_SAMPLER_INDEPENDENT : MURK_SAMPLER_SOBOL, 11u + (uint64_t)r, 128, 10, z[smp],
-                                 &se[smp]);
-                    for (int j = 0; j < NSTATS; j++)
-                        bad |= !(fabs(z[smp][j]) <= ZMAX);
+                                 smp ? MURK_SAMPLER_INDEPENDENT : MURK_SAMPLER_SOBOL, 11u + (uint64_t)r, NPIX, 10, z[smp],
+                                 zm[smp], &se[smp]);
+                    for (int j = 0; j < NSTATS; j++) {
+                        stat_count(1, stat_tail2_t(STAT_Z, NPIX - 1)); /* t: the se from NPIX pixel means */
+                        bad |= !(fabs(z[smp][j]) <= STAT_Z);
+                        zshort[i] = fmax(zshort[i], smp ? 0.0 : fabs(zm[smp][j]));
+                    }
                 }
                 printf("  %-15s", ms[i].label);
                 for (int smp = 0; smp < 2; smp++) {
@@ -315,14 +328,21 @@ static void test_first_distance(void **state)
                 nbad += bad;
             }
         }
+        /* the must-fail cases: each tracker's first flights SHORT short (sobol), over the medium's rays */
+        for (int i = 0; i < NCONFIGS; i++) {
+            char label[96];
+            snprintf(label, sizeof label, "%s %s: first flights %g%% short", media[md].name, ms[i].label, 100.0 * SHORT);
+            nbad += !stat_must_fail(label, zshort[i] > STAT_Z, zshort[i]);
+            zshort[i] = 0.0;
+        }
         murk_scene_free(s);
     }
     free(D);
     assert_int_equal(nbad, 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_first_choice), cmocka_unit_test(test_first_distance)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

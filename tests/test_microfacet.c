@@ -5,11 +5,12 @@
  * Heitz 2014's closed forms, and the dielectric Fresnel equals ((n - 1) / (n + 1))^2 at normal
  * incidence, Fresnel's sine and tangent laws at oblique incidence, and 1 under total internal
  * reflection. */
-#include "testutil.h"
+#include "stat.h"
 
 #include "murk/microfacet.h"
 
 #include <math.h>
+#include <stdio.h>
 
 static const double PI = 3.14159265358979323846;
 
@@ -84,8 +85,8 @@ static void test_vndf_pdf_integrates_to_one(void **state)
 }
 
 /* Sample means of m.x and m.z over n visible normals drawn with width alpha_s, against the moments of
- * the density of width alpha: returns the larger deviation in units of its standard error. */
-static double vndf_sample_deviation(murk_vec3 wo, float alpha, float alpha_s, long n)
+ * the density of width alpha: the deviations in units of their standard errors (z[0]: m.x, z[1]: m.z). */
+static void vndf_sample_deviation(murk_vec3 wo, float alpha, float alpha_s, long n, double z[2])
 {
     double mom[5];
     vndf_moments(wo, alpha, mom);
@@ -100,29 +101,34 @@ static double vndf_sample_deviation(murk_vec3 wo, float alpha, float alpha_s, lo
     }
     double ex = mom[1] / mom[0], ez = mom[2] / mom[0];
     double se_x = sqrt((mom[3] / mom[0] - ex * ex) / n), se_z = sqrt((mom[4] / mom[0] - ez * ez) / n);
-    return fmax(fabs(sx / n - ex) / se_x, fabs(sz / n - ez) / se_z);
+    z[0] = (sx / n - ex) / se_x;
+    z[1] = (sz / n - ez) / se_z;
 }
 
-/* murk_ggx_sample_vndf draws from murk_ggx_vndf_pdf: the moments agree within 4 standard errors (plus
- * the quadrature's own error, far below one standard error at this n); sampling with an alpha 15 %
- * too large, a biased sampler, must fail the same bound. */
+/* murk_ggx_sample_vndf draws from murk_ggx_vndf_pdf: the moments agree within STAT_Z standard errors
+ * (stat.h; the quadrature's own error is far below one standard error at this n); the must-fail case,
+ * sampling with an alpha 15 % too large (a biased sampler), fails the same bound. */
 static void test_vndf_sampling_matches_pdf(void **state)
 {
     (void)state;
-    const long n = 200000;
+    const long n = stat_n(200000);
     const double alphas[] = {0.3, 0.8}, thetas[] = {30.0, 70.0};
     for (int a = 0; a < 2; a++)
         for (int t = 0; t < 2; t++) {
             double th = thetas[t] * PI / 180.0;
             murk_vec3 wo = dir(cos(th), 0.3);
             float al = (float)alphas[a];
-            double dev = vndf_sample_deviation(wo, al, al, n);
-            if (dev > 4.0)
-                fail_msg("alpha %g, theta %g: sample moments %.2f standard errors off", alphas[a], thetas[t], dev);
-            double bad = vndf_sample_deviation(wo, al, 1.15f * al, n);
-            if (bad <= 4.0)
-                fail_msg("alpha %g, theta %g: the biased sampler passes (%.2f standard errors)", alphas[a], thetas[t],
-                         bad);
+            double z[2], zb[2];
+            vndf_sample_deviation(wo, al, al, n, z);
+            printf("alpha %g, theta %g: sample moments %+.2f, %+.2f standard errors off\n", alphas[a], thetas[t], z[0],
+                   z[1]);
+            for (int k = 0; k < 2; k++)
+                assert_true(stat_z_ok(z[k], 1.0, 0.0, 0.0));
+            vndf_sample_deviation(wo, al, 1.15f * al, n, zb);
+            double worst = fabs(zb[0]) > fabs(zb[1]) ? zb[0] : zb[1];
+            char label[96];
+            snprintf(label, sizeof label, "vndf alpha %g theta %g, sampled with alpha x 1.15", alphas[a], thetas[t]);
+            assert_true(stat_must_fail(label, fabs(worst) > STAT_Z, worst));
         }
 }
 
@@ -198,7 +204,7 @@ static void test_schlick_and_reflect(void **state)
     assert_near(murk_clamp01(2.0f), 1.0, 0.0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_d_normalised),
@@ -208,5 +214,5 @@ int main(void)
         cmocka_unit_test(test_fresnel_dielectric),
         cmocka_unit_test(test_schlick_and_reflect),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

@@ -2,6 +2,7 @@
  * against its closed form, 1-vs-2-thread bitwise determinism, and the Cornell box (finite pixels, EXR
  * metadata read back through OpenEXRCore). */
 #include "testutil.h"
+#include "stat.h"
 #include "image/image.h"
 
 #include <math.h>
@@ -112,7 +113,9 @@ static void test_closed_box(void **state)
     image_stats(&img, &mean, &se, &maxdev, expect);
     printf("closed box: mean %.5f +- %.5f (expected %.5f)\n", mean, se, expect);
     assert_true(se > 0.0 && se < 0.01);
-    assert_true(fabs(mean - expect) < 4.0 * se);
+    assert_true(stat_z_ok(mean, se, expect, 0.0));
+    double zd = fabs(mean - 0.98 * expect) / se; /* must-fail: a box 2 % darker */
+    assert_true(stat_must_fail("closed box against 2% darker", zd > STAT_Z, zd));
     murk_image_free(&img);
 }
 
@@ -162,7 +165,7 @@ static void test_cornell(void **state)
     murk_image_free(&p);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_white_furnace),
@@ -170,5 +173,5 @@ int main(void)
         cmocka_unit_test(test_threads_bitwise),
         cmocka_unit_test(test_cornell),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

@@ -2,8 +2,7 @@
  * tracer's default integrator.rr_threshold (0.3: play only with paths whose weight fell below 0.3) against
  * 1 (every path below 1, murk's rule before) and against 0.1 (Tungsten's rule), on the Cornell box (path),
  * cornell_smoke's cloud (volpath_nee, delta tracking) and a constant chromatic medium in the same box,
- * independent seeds, block-wise z (img_stack_agree: no 4x4 block beyond 4.5 sigma, the mean z within
- * 4 / sqrt(blocks)). Roulette divides a survivor by its survival probability, so every rule estimates the
+ * independent seeds, block-wise z (img_stack_agree: 4x4 blocks, its bounds from stat.h). Roulette divides a survivor by its survival probability, so every rule estimates the
  * same image whatever the threshold; a rule that forgot the division, or divided by the wrong probability,
  * would not. Must fail, on each scene: the default with the lamp 1 % brighter against threshold 1. */
 #include "testutil.h"
@@ -65,11 +64,11 @@ static void test_threshold_keeps_image(void **state)
         img_stack_render(&t, src_path(scene), "rr01.exr", SEEDS, 400, rule01);
         img_stack_render(&m, src_path(scene), "rr_bright.exr", SEEDS, 300, bright);
         snprintf(label, sizeof label, "%s: rr_threshold default (0.3) against 1", c->label);
-        nfail += !img_stack_agree(label, &a, &b, BLOCK, 4.5);
+        nfail += !img_stack_agree(label, &a, &b, BLOCK);
         snprintf(label, sizeof label, "%s: rr_threshold 0.1 against 1", c->label);
-        nfail += !img_stack_agree(label, &t, &b, BLOCK, 4.5);
+        nfail += !img_stack_agree(label, &t, &b, BLOCK);
         snprintf(label, sizeof label, "%s: rr_threshold default with the lamp 1.01 x against 1 (must fail)", c->label);
-        nmissed += img_stack_agree(label, &m, &b, BLOCK, 4.5);
+        nmissed += img_stack_agree(label, &m, &b, BLOCK);
         img_stack_free(&t);
         img_stack_free(&a);
         img_stack_free(&b);

@@ -6,6 +6,7 @@
  * read and checked like every scene key. And the solid-angle sampling of rectangular lights
  * (MURK_LIGHT_SOLID_ANGLE, lights.c): a chi-square of the sampled points against the pdf. */
 #include "testutil.h"
+#include "stat.h"
 #include "render/host.h"
 #include "image/image.h"
 #include "scene/scene.h"
@@ -101,13 +102,14 @@ static double correlation(uint64_t s1, uint64_t p1, uint32_t slot1, uint64_t s2,
     return cov / sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n)));
 }
 
-/* Neighbouring pixels, seeds and slots see different, uncorrelated sequences: |corr| within 4 standard
- * errors (1 / sqrt(n) for independent uniforms) and no point shared. */
+/* Neighbouring pixels, seeds and slots see different, uncorrelated sequences: |corr| within STAT_Z standard
+ * errors (1 / sqrt(n) for independent uniforms) and no point shared. Must-fail: a mutant sequence that
+ * repeats the other's number at every fifth sample (correlation 0.2). */
 static void test_decorrelated(void **state)
 {
     (void)state;
     const uint32_t n = 4096;
-    const double tol = 4.0 / sqrt((double)n);
+    const double tol = STAT_Z / sqrt((double)n);
     struct { uint64_t s1, p1, s2, p2; uint32_t slot1, slot2; const char *what; } cases[] = {
         {0, 100, 0, 101, 0, 0, "neighbouring pixels"}, {0, 100, 1, 100, 0, 0, "seeds 0 and 1"},
         {5, 7, 5, 7 + 512, 4, 4, "pixels a row apart"}, {5, 7, 5, 7, 3, 4, "slots 3 and 4"},
@@ -120,9 +122,21 @@ static void test_decorrelated(void **state)
                                    n, &same);
             printf("%-26s coordinate %d: correlation %+.4f (limit %.4f), %u shared points\n", cases[i].what, c, r, tol,
                    same);
-            assert_true(fabs(r) < tol);
+            assert_true(stat_z_ok(r, 1.0 / sqrt((double)n), 0.0, 0.0));
             assert_int_equal(same, 0);
         }
+    double sa = 0, sb = 0, sab = 0, saa = 0, sbb = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        float a[2], b[2];
+        point(MURK_SAMPLER_SOBOL, 0, 100, i, 0, a);
+        point(MURK_SAMPLER_SOBOL, 0, 101, i, 0, b);
+        double x = a[0], y = i % 5 == 0 ? a[0] : b[0];
+        sa += x, sb += y, sab += x * y, saa += x * x, sbb += y * y;
+    }
+    double r = (sab / n - sa / n * sb / n) / sqrt((saa / n - sa / n * sa / n) * (sbb / n - sb / n * sb / n));
+    double z = r * sqrt((double)n);
+    printf("mutant (every fifth number repeated): correlation %+.4f (limit %.4f)\n", r, tol);
+    assert_true(stat_must_fail("neighbouring pixels, every fifth number shared", fabs(z) > STAT_Z, z));
 }
 
 /* The Sobol points exactly as murk/math.h's comment defines them, computed here bit by bit with no
@@ -268,8 +282,11 @@ static double slope(const double *y, const double *se, int k0, int k1, double *s
 }
 
 /* The disk's area (a discontinuous integrand): independent numbers converge as N^-1/2, scrambled Sobol
- * as N^-3/4 (variance N^-3/2, Owen 1997). The fitted slope must lie 4 standard errors below -1/2, and
- * at N = 1024 the RMSE must be below independent's by more than 4 standard errors. */
+ * as N^-3/4 (variance N^-3/2, Owen 1997). The fitted slope must lie STAT_Z standard errors below -1/2, and
+ * at N = 1024 the RMSE must be below independent's by more than STAT_Z standard errors; independent
+ * numbers' slope within STAT_Z standard errors of -1/2 (the harness sees Monte Carlo's rate). The
+ * standard errors treat the powers of two as independent, which they are not (each N's points hold the
+ * smaller N's): the slopes' true spread is somewhat larger than printed. */
 static void test_disk_convergence(void **state)
 {
     (void)state;
@@ -281,9 +298,10 @@ static void test_disk_convergence(void **state)
     printf("disk area RMSE slope over N = 16..1024: sobol %.3f +- %.3f, independent %.3f +- %.3f\n", bs, ss, bi, si);
     printf("RMSE at N = 1024: sobol %.3g, independent %.3g (ratio %.1f)\n", exp2(ys[KMAX]), exp2(yi[KMAX]),
            exp2(yi[KMAX] - ys[KMAX]));
-    assert_true(fabs(bi + 0.5) < 4.0 * si);  /* the harness sees Monte Carlo's rate */
-    assert_true(bs + 4.0 * ss < -0.5);        /* measurably faster than it */
-    assert_true(ys[KMAX] + 4.0 * hypot(ses[KMAX], sei[KMAX]) < yi[KMAX]);
+    assert_true(stat_z_ok(bi, si, -0.5, 0.0)); /* the harness sees Monte Carlo's rate */
+    stat_count(2, stat_tail2(STAT_Z) / 2.0);   /* one-sided: */
+    assert_true(bs + STAT_Z * ss < -0.5);      /* measurably faster than it */
+    assert_true(ys[KMAX] + STAT_Z * hypot(ses[KMAX], sei[KMAX]) < yi[KMAX]);
 }
 
 /* ---- renders ------------------------------------------------------------------------------- */
@@ -354,8 +372,8 @@ static void test_scene_key(void **state)
  * points:
  * 200k samples binned 16 x 16 over the rectangle's (a, b) coordinates against the expected counts
  * N * integral over the bin of pdf(w) dw = N * sum pdf cos_l / d^2 dA (32 x 32 midpoints per bin);
- * p >= 1e-4, the expected counts sum to N (the pdf integrates to 1) and every sample's pdf equals
- * light_pdf_with() at its point. */
+ * p >= STAT_P (stat.h), the expected counts sum to N (the pdf integrates to 1) and every sample's pdf
+ * equals light_pdf_with() at its point. Must-fail: the same samples against area sampling's pdf. */
 static void test_rect_light_chi2(void **state)
 {
     (void)state;
@@ -383,9 +401,10 @@ static void test_rect_light_chi2(void **state)
         murk_vec3 p = murk_add(c, murk_add(murk_add(murk_mul(murk_normalize(u), pts[k][0]), murk_mul(murk_normalize(v), pts[k][1])),
                                            murk_mul(n, pts[k][2])));
         assert_true(murk_dot(murk_sub(p, p0), n) > 0.0f); /* on the emitting side */
-        static double obs[NB * NB], expct[NB * NB];
+        static double obs[NB * NB], expct[NB * NB], wrong[NB * NB];
         memset(obs, 0, sizeof obs);
         memset(expct, 0, sizeof expct);
+        memset(wrong, 0, sizeof wrong);
         murk_rng rng;
         murk_rng_seed(&rng, 15, k, 0);
         long bad_pdf = 0;
@@ -419,14 +438,18 @@ static void test_rect_light_chi2(void **state)
                 double dA = area / ((double)NB * SUB * NB * SUB);
                 double e = h->light_pdf_with(s, p, &hit, MURK_LIGHT_SOLID_ANGLE) * cosl / d2 * dA;
                 expct[(ia / SUB) * NB + ib / SUB] += N * e;
+                wrong[(ia / SUB) * NB + ib / SUB] += N * h->light_pdf_with(s, p, &hit, MURK_LIGHT_AREA) * cosl / d2 * dA;
                 total += e;
             }
         int dof;
         double pv = chi2_test(obs, expct, NB * NB, 5.0, &dof);
         printf("rectangle light from (%.2f, %.2f, %.2f): chi2 p = %.4f (%d dof), integral of pdf %.5f, "
                "%ld pdf mismatches\n", p.x, p.y, p.z, pv, dof, total, bad_pdf);
-        assert_true(pv >= 1e-4);
+        assert_true(stat_chi2_ok(pv));
         assert_true(fabs(total - 1.0) < 2e-3);
+        char label[96];
+        snprintf(label, sizeof label, "rectangle light point %zu: against area sampling's pdf", k);
+        assert_true(stat_must_fail_chi2(label, chi2_test(obs, wrong, NB * NB, 5.0, &dof)));
         assert_int_equal(bad_pdf, 0);
     }
     murk_scene_free(s);
@@ -435,9 +458,10 @@ static void test_rect_light_chi2(void **state)
 /* ---- the expected image ------------------------------------------------------------------------ */
 
 /* The sobol sampler with solid-angle light sampling against (independent, area), murk's estimators
- * before both: two estimators of the same image, block-wise z-test over 6 seeds each (img_stack_agree,
- * |z| <= 4.5 per 4x4 block) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium. */
-static void test_same_image(void **state)
+ * before both: two estimators of the same image, block-wise z-test over 8 independent seeds each
+ * (img_stack_agree) on the Cornell box, cornell_smoke's cloud and a constant chromatic medium (suite
+ * 'long'); must-fail: one block brighter by 10 of its standard errors (the resolution, printed). */
+static void long_same_image(void **state)
 {
     (void)state;
     static const char *const medium[] = {"--set", "media.smoke.density={constant: 1}", "--set",
@@ -459,16 +483,17 @@ static void test_same_image(void **state)
         b_args[n + 2] = "--set", b_args[n + 3] = "integrator.light_sampling=area", b_args[n + 4] = NULL;
         a_args[n] = "--set", a_args[n + 1] = "integrator.light_sampling=solid_angle", a_args[n + 2] = NULL;
         img_stack a, b;
-        img_stack_render(&a, src_path(cases[i].scene), "new.exr", 6, 10, a_args);
-        img_stack_render(&b, src_path(cases[i].scene), "old.exr", 6, 1000, b_args);
-        nfail += !img_stack_agree(cases[i].label, &a, &b, 4, 4.5);
+        img_stack_render(&a, src_path(cases[i].scene), "new.exr", 8, 10, a_args);
+        img_stack_render(&b, src_path(cases[i].scene), "old.exr", 8, 1000, b_args);
+        nfail += !img_stack_agree(cases[i].label, &a, &b, 4);
+        nfail += !img_stack_must_differ_block(cases[i].label, &a, &b, 4, 0.0);
         img_stack_free(&a);
         img_stack_free(&b);
     }
     assert_int_equal(nfail, 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stratified),
@@ -479,7 +504,7 @@ int main(void)
         cmocka_unit_test(test_rect_light_chi2),
         cmocka_unit_test(test_scene_key),
         cmocka_unit_test(test_render_bitwise),
-        cmocka_unit_test(test_same_image),
+        cmocka_unit_test(long_same_image),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

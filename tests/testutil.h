@@ -66,13 +66,22 @@ void img_stack_render(img_stack *st, const char *scene, const char *out, int nse
                       const char *const *extra);
 void img_stack_free(img_stack *st);
 
-/* Block-wise z-test of a against the reference r: per block of block x block pixels and channel, the
- * difference of block means over its standard error from both stacks' per-pixel variances. They agree
- * when no block differs by more than zmax sigma in any channel and the mean over blocks of the
- * channel-average z is within 4 / sqrt(nblocks) of 0 (independent blocks, each z ~ N(0, 1)). Prints
- * one line (worst block, mean z, the reference's block standard error in percent) and returns 1 if
- * they agree. Fewer than 16 blocks with signal is a failure (too little to judge). */
-int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, int block, double zmax);
+/* Block-wise z-test of a against the reference r (two independent estimates of one image: independent
+ * seeds): per block of block x block pixels and channel, the difference of block means over its standard
+ * error from both stacks' per-pixel variances. They agree when no block differs by more than STAT_Z
+ * sigma in any channel and the mean over blocks of the channel-average z is within STAT_Z / sqrt(nblocks)
+ * of 0 (independent blocks, each z ~ N(0, 1)); stat.h counts every block and channel as a decision. The
+ * per-pixel variances come from the seeds (n - 1 degrees of freedom each, summed over a block's pixels).
+ * Prints one line (worst block, mean z, the reference's block standard error in percent) and returns 1
+ * if they agree. Fewer than 16 blocks with signal is a failure (too little to judge). */
+int img_stack_agree(const char *label, const img_stack *a, const img_stack *r, int block);
+/* The same comparison as a must-fail case (stat_must_fail, not counted as decisions): a has a known bias
+ * and must differ. Returns 1 if it does. */
+int img_stack_must_differ(const char *label, const img_stack *a, const img_stack *r, int block);
+/* The must-fail case "a bias in one block": a with its centre block's means times 1 + bias against r.
+ * bias <= 0: 10 standard errors of that block's difference in its noisiest channel (printed in percent:
+ * the comparison's resolution where no mutant of the renderer is at hand). */
+int img_stack_must_differ_block(const char *label, const img_stack *a, const img_stack *r, int block, double bias);
 
 /* Pearson chi-square test of observed counts against expected counts, merging bins (in order of
  * increasing expectation) until each holds at least min_expected. Returns the p-value. */

@@ -32,8 +32,9 @@
  *               ctx (hero and beta may steer the sampling, never the expectation). Non-negative is
  *               expected; a negative channel is allowed only from an estimator documented unbiased
  *               that produces it by design (power-series corrections, weighted collisions where a bound
- *               fails) — the path tracer multiplies it in like any other value. An all-zero result means
- *               opaque: the shadow ray stops. An estimator that is biased by design (raymarch) must say
+ *               fails) — the path tracer multiplies it in like any other value; such an estimator says so
+ *               in its one-line description (the word "negative"), or `murk check` holds it to
+ *               non-negative estimates. An all-zero result means opaque: the shadow ray stops. An estimator that is biased by design (raymarch) must say
  *               so in its description, its header comment and a log line at create().
  *   Bounds      the majorant walk's dmax bounds the density only when majorant_factor >= 1, and dmin
  *               (the minorant) is a lower bound of the unscaled density. Where they fail, an unbiased
