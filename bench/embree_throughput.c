@@ -40,7 +40,8 @@
  * so the replay runs more rays per second than the raw side, and murk / raw flatters murk by that factor
  * (bench/throughput.md has it). murk / replay is the like-for-like ratio (the same Embree work on both
  * sides); it is also the share of murk's time spent inside Embree. Both are printed; the issue's goal
- * (70 %) was stated against raw. bench/throughput.md has the figures and where the rest of murk's time
+ * (70 %) was stated against raw. On a scene the bare tracer supports, murk / bare (murk's rays per second
+ * over the `bare` rung's, per round) is the yardstick of murk's layers: what the plugin design costs. bench/throughput.md has the figures and where the rest of murk's time
  * goes.
  *
  * Then the media figure, on scenes/cornell_smoke.yaml's cloud with the `delta` tracker (grey extinction):
@@ -227,10 +228,14 @@ static double murk_side(murk_scene *s, double seconds, int *spp, double *mean)
  * camera ray (murk_camera_sample), rtcIntersect1 / rtcOccluded1 called here, the hit point o + t d and the
  * triangle's stored normal, the albedo read once per shape before timing (the material's eval at normal
  * incidence, times pi), NEE by area with the power heuristic against cosine sampling, emission weighted
- * the same way, murk's Russian roulette (after 3 events, q = max(beta) clamped to [0.05, 1]), max depth
+ * the same way, murk's Russian roulette (after 3 events, q = max(beta) / 0.3 clamped to [0.05, 1]: the default
+ * rr_threshold), max depth
  * 64. No plugin calls, no murk_hit, no NaN checks, no boundaries, no media. Its numbers come from murk's
  * sampler: `bare` with the scene's (sobol), `bare-pcg` with independent numbers. Its image agrees with
  * murk's in expectation (the mean of both renders is printed). Rays counted per Embree call, as murk's. */
+/* the path integrators' default rr_threshold (pathtracer.c), so that the bare paths are as long as murk's */
+#define BARE_RR_THRESHOLD 0.3f
+
 typedef struct bare_pt {
     const murk_scene *s;
     murk_rgb *albedo; /* per shape */
@@ -438,7 +443,7 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
         prev_p = p;
         prev_cam = 0;
         if (depth + 1 > 3) {
-            float qq = murk_maxf(0.05f, murk_minf(1.0f, murk_maxf(beta.c[0], murk_maxf(beta.c[1], beta.c[2]))));
+            float qq = murk_maxf(0.05f, murk_minf(1.0f, murk_maxf(beta.c[0], murk_maxf(beta.c[1], beta.c[2])) / BARE_RR_THRESHOLD));
             murk_sample_seek(rng, 2u + (uint32_t)depth * 5u + 4u);
             if (murk_sample_1d(rng) >= qq)
                 break;
@@ -650,8 +655,9 @@ int main(int argc, char **argv)
     for (int j = 0; bare && j < BARE_RUNGS; j++)
         printf("  %s/raw", bare_rung_name[j]);
     printf("\n");
-    double *ratio = murk_xmalloc((2 + BARE_RUNGS) * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds,
-           *bratio = rratio + rounds; /* bratio[j * rounds + k] */
+    double *ratio = murk_xmalloc((3 + BARE_RUNGS) * (size_t)rounds * sizeof *ratio), *rratio = ratio + rounds,
+           *bratio = rratio + rounds, /* bratio[j * rounds + k] */
+        *lratio = bratio + BARE_RUNGS * (size_t)rounds; /* murk / bare (sobol): what murk's layers leave */
     double bmean[BARE_RUNGS] = {0}, mmean = 0.0;
     for (int k = 0; k < rounds; k++) {
         uint64_t nraw;
@@ -673,6 +679,7 @@ int main(int argc, char **argv)
         rratio[k] = mr / rep;
         printf("%5d  %11.2f  %14.2f  %12.2f  %6.1f %%  %9.1f %%", k + 1, raw / 1e6, rep / 1e6, mr / 1e6, 100.0 * ratio[k],
                100.0 * rratio[k]);
+        lratio[k] = bare ? mr / br[BARE] : 0.0; /* the bare tracer with the scene's sampler */
         for (int j = 0; bare && j < BARE_RUNGS; j++) {
             bratio[j * rounds + k] = br[j] / raw;
             printf("  %*.1f %%", (int)strlen(bare_rung_name[j]) + 2, 100.0 * bratio[j * rounds + k]);
@@ -684,6 +691,8 @@ int main(int argc, char **argv)
     if (bare) {
         for (int j = 0; j < BARE_RUNGS; j++)
             printf("%s / raw Embree: %s\n", bare_rung_name[j], median_spread(bratio + j * rounds, rounds));
+        printf("murk / bare (the layers' ratio: murk's rays per CPU second over the bare tracer's with the same "
+               "sampler, per round): %s\n", median_spread(lratio, rounds));
         printf("image means (all channels, over the rounds): murk %.5f", mmean);
         for (int j = 0; j < BARE_RUNGS; j++)
             printf(", %s %.5f", bare_rung_name[j], bmean[j]);

@@ -79,6 +79,9 @@ VARIANTS = {"before": ["--set", "integrator.light_sampling=area", "--set", "inte
                        "--set", "media.{m}.stratify_flights=false"],
             "solid_angle": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=1"],
             "rr0.1": ["--set", "integrator.light_sampling=area", "--set", "integrator.rr_threshold=0.1"],
+            # Russian roulette's threshold alone (murk's rule 1, Tungsten's 0.1, and between)
+            "rr1": ["--set", "integrator.rr_threshold=1"],
+            "rr0.3": ["--set", "integrator.rr_threshold=0.3"],
             "both": ["--set", "integrator.light_sampling=solid_angle", "--set", "integrator.rr_threshold=0.1"],
             "equiangular": ["--set", "integrator.equiangular=true"],
             "smis": ["--set", "media.{m}.type=spectral_mis"],

@@ -23,7 +23,7 @@ static const char tiny[] =
     "murk: 1\n"
     "render: { resolution: [24, 24], spp: 4, seed: 0 }\n"
     "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 40 }\n"
-    "integrator: { type: volpath_nee, max_depth: 16 }\n"
+    "integrator: { type: volpath_nee, max_depth: 16, rr_threshold: 1 }\n" /* corrected_relmse_of_two_seeds' tolerance */
     "background: %s\n"
     "materials: { white: { type: diffuse, albedo: 0.7 } }\n"
     "media:\n"

@@ -64,10 +64,29 @@ _Static_assert(sizeof(walk) <= sizeof(murk_majorant_walk), "murk_majorant_walk t
 
 /* ---- host services ------------------------------------------------------------------------- */
 
+/* The lookups being recorded (murk_media_record_lookups), or NULL: one predictable branch per call. */
+static murk_lookup_record *lookup_record;
+
+void murk_media_record_lookups(murk_lookup_record *rec) { lookup_record = rec; }
+
+static void record_lookup(int kind, const murk_density *d, const void *w, const murk_ray *r, float t0, float t1)
+{
+    murk_lookup_record *rec = lookup_record;
+    if (rec->n < rec->cap)
+        rec->ev[rec->n] = (murk_lookup_event){d, w, *r, t0, t1, kind};
+    rec->n++;
+}
+
 float murk_media_density(const murk_density *d, murk_vec3 p)
 {
     murk_thread_counters()[d->slot].lookups++;
-    return murk_field_eval(d->field, p);
+    float v = murk_field_eval(d->field, p);
+    if (lookup_record) {
+        murk_ray r = {p, p, 0.0f, 0.0f};
+        record_lookup(MURK_LOOKUP_DENSITY, d, NULL, &r, 0.0f, 0.0f);
+        lookup_record->sum += (double)v;
+    }
+    return v;
 }
 
 murk_counters *murk_media_counters(const murk_density *d) { return &murk_thread_counters()[d->slot]; }
@@ -83,6 +102,8 @@ void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, 
     }
     k->factor = d->factor;
     k->count = &murk_thread_counters()[d->slot];
+    if (lookup_record)
+        record_lookup(MURK_LOOKUP_WALK_INIT, d, w, ray, t0, t1);
 }
 
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin)
@@ -91,6 +112,10 @@ int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dma
     float mx = 0.0f, mn = 0.0f;
     int r = murk_dda_next(&k->dda, ta, tb, &mx, &mn);
     k->count->cells += (unsigned)r;
+    if (lookup_record) {
+        murk_ray none = {{0, 0, 0}, {0, 0, 0}, 0.0f, 0.0f};
+        record_lookup(MURK_LOOKUP_WALK_NEXT, NULL, w, &none, 0.0f, 0.0f);
+    }
     if (dmax)
         *dmax = mx * k->factor;
     if (dmin)

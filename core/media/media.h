@@ -46,6 +46,26 @@ void murk_density_parts(const murk_density *d, const struct murk_field **field, 
                         float *factor);
 
 float murk_media_density(const murk_density *d, murk_vec3 p);
+/* The density lookups and majorant walks a render makes, in order: bench/long_paths replays them with
+ * nothing else around them. Each event is a density() call (kind MURK_LOOKUP_DENSITY at ray.o), a
+ * walk_init() (MURK_LOOKUP_WALK_INIT with its ray, t0 and t1) or a walk_next() (MURK_LOOKUP_WALK_NEXT);
+ * `walk` tells the walks apart (its address). n counts every event (it may pass cap: the first cap are
+ * kept); sum adds every density() result. Record with one render thread. */
+enum { MURK_LOOKUP_DENSITY, MURK_LOOKUP_WALK_INIT, MURK_LOOKUP_WALK_NEXT };
+typedef struct murk_lookup_event {
+    const murk_density *d;
+    const void *walk;
+    murk_ray ray;
+    float t0, t1;
+    int kind;
+} murk_lookup_event;
+typedef struct murk_lookup_record {
+    murk_lookup_event *ev;
+    size_t n, cap;
+    double sum;
+} murk_lookup_record;
+/* Records every lookup and walk step from now on into rec (NULL: stop). Only while no render runs. */
+void murk_media_record_lookups(murk_lookup_record *rec);
 void murk_media_walk_init(const murk_density *d, const murk_ray *ray, float t0, float t1, murk_majorant_walk *w);
 int murk_media_walk_next(murk_majorant_walk *w, float *ta, float *tb, float *dmax, float *dmin);
 /* The calling thread's cost counters for d's medium (runtime.h): the host's counters() service. */
