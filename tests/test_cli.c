@@ -263,7 +263,7 @@ static int render_cornell(const char *exr, const char *spp, const char *const *e
 
 /* An output that cannot be written — the image in a folder that does not exist or is a file, its PNG
  * preview a directory, MURK_SAMPLE_DUMP's file in a missing folder, a folder without write permission —
- * is a one-line error, exit 1, in less than a second on a render that takes several: murk found it only
+ * is a one-line error, exit 1, in under half the time of a render of about 5 s: murk found it only
  * when writing, after the whole render. Nothing is written. */
 static void test_outputs_checked_first(void **state)
 {
@@ -297,7 +297,7 @@ static void test_outputs_checked_first(void **state)
             setenv("MURK_SAMPLE_DUMP", tmp_path(cases[i].dump), 1);
         int rc = render_cornell(tmp_path(cases[i].exr), spp, NULL, &out, &secs);
         unsetenv("MURK_SAMPLE_DUMP");
-        if (secs >= 1.0)
+        if (secs >= 2.5) /* half the render's 5 s: start-up alone may take a second (sanitizers, load) */
             fail_msg("%s: refused after %.2f s, not before rendering:\n%s", cases[i].exr, secs, out);
         assert_int_equal(rc, 1);
         assert_contains(out, cases[i].says);

@@ -126,7 +126,10 @@ int main(void)
 }
 EOF
 # shellcheck disable=SC2046 # pkg-config's flags are words
-cc -std=c11 -Wall -Wextra -Werror $(pkg-config --cflags murk-lab) -o "$TMP/schema" "$TMP/schema.c" \
+# under a sanitized build (CI's stage 2) libmurklab needs its runtime in the program too
+SAN=
+[ "${MURK_B_SANITIZE:-none}" = none ] || SAN="-fsanitize=$MURK_B_SANITIZE"
+cc -std=c11 -Wall -Wextra -Werror $SAN $(pkg-config --cflags murk-lab) -o "$TMP/schema" "$TMP/schema.c" \
   $(pkg-config --libs murk-lab) || fail "building against murk-lab.pc"
 LD_LIBRARY_PATH=$(dirname "$LIBLAB") "$TMP/schema" || fail "the program on libmurklab"
 
