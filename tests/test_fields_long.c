@@ -3,7 +3,7 @@
  *   - a scattering, absorbing, emitting medium (fBm density, a grey albedo cloud, a
  *     temperature cloud with blackbody emission, chromatic extinction) lit by a lamp: delta,
  *     decomposition, spectral, spectral_mis, naive_spectral and the SDK's example_delta render the same
- *     expected image (block-wise z against delta, independent seeds); the negative control, emission 3 %
+ *     expected image (block-wise z against delta, independent seeds); the negative control, emission 20 %
  *     brighter, must differ;
  *   - volpath_nee's nee_mis: null_scattering renders the image of solid_angle (spectral_mis in a dense
  *     chromatic medium, independent seeds); the negative control, the lamp 3 % brighter, must differ.
@@ -44,17 +44,20 @@ static void test_trackers_agree_on_emission(void **state)
     (void)state;
     setenv("MURK_PLUGIN_PATH", build_path("tests/fixtures"), 1); /* example_delta */
     img_stack ref = {0}, m = {0};
-    img_stack_render(&ref, emit_scene("delta", "30"), "emit.exr", SEEDS, 100, NULL);
+    /* emission 1500 scales the blackbody of a cloud mostly below 1000 K: the medium's own light is then
+     * a large part of the image (at 30 it was about 2 %, and a 3 % error in it was invisible). Its
+     * hot spots make it noisy (block se about 0.9 %): the must-fail is emission 20 % too strong */
+    img_stack_render(&ref, emit_scene("delta", "1500"), "emit.exr", SEEDS, 100, NULL);
     static const char *const trackers[] = {"decomposition", "spectral", "spectral_mis", "naive_spectral",
                                            "example_delta"};
     int bad = 0;
     for (int i = 0; i < 5; i++) {
-        img_stack_render(&m, emit_scene(trackers[i], "30"), "emit.exr", SEEDS, 200 + 10 * i, NULL);
+        img_stack_render(&m, emit_scene(trackers[i], "1500"), "emit.exr", SEEDS, 200 + 10 * i, NULL);
         bad += !img_stack_agree(trackers[i], &m, &ref, BLOCK);
         img_stack_free(&m);
     }
-    img_stack_render(&m, emit_scene("delta", "30.9"), "emit.exr", SEEDS, 300, NULL);
-    int differs = img_stack_must_differ("delta, emission x 1.03", &m, &ref, BLOCK);
+    img_stack_render(&m, emit_scene("delta", "1800"), "emit.exr", SEEDS, 300, NULL);
+    int differs = img_stack_must_differ("delta, emission x 1.2", &m, &ref, BLOCK);
     img_stack_free(&m);
     img_stack_free(&ref);
     assert_int_equal(bad, 0);
