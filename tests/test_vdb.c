@@ -690,7 +690,8 @@ static float checker_with_border(int x, int y, int z, float cx, float cy, float 
     return ((x + y + z) & 1) ? 1.4f : 0.2f;
 }
 
-static void test_vdb_images(void **state)
+/* suite 'long' (test_vdb --long): the image comparison takes most of the program's time */
+static void long_vdb_images(void **state)
 {
     (void)state;
     murk_vec3 lo = murk_v3(-0.6f, 0.05f, -0.6f), hi = murk_v3(0.6f, 1.45f, 0.6f);
@@ -863,7 +864,7 @@ static void test_vdb_bad_scenes(void **state)
     expect_scene_error(sing, "density", NULL, "density vdb:");
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sparse_equals_dense),
@@ -872,11 +873,11 @@ int main(void)
         cmocka_unit_test(test_vdb_grids),
         cmocka_unit_test(test_vdb_closed_form),
         cmocka_unit_test(test_vdb_rotated),
-        cmocka_unit_test(test_vdb_images),
+        cmocka_unit_test(long_vdb_images),
         cmocka_unit_test(test_vdb_memory),
         cmocka_unit_test(test_vdb_bad_scenes),
     };
     if (getenv("MURK_TEST_FILTER")) /* e.g. MURK_TEST_FILTER='test_vdb_*' */
         cmocka_set_test_filter(getenv("MURK_TEST_FILTER"));
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }
