@@ -421,24 +421,6 @@ static void test_bad_input(void **state)
     expect_error(shape, "{ from_asset: 1, from: [0, 0, 1] }", "'from' and from_asset exclude each other");
 }
 
-/* 1 if the files at a and b hold the same bytes. */
-static int same_bytes(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        same = ca == cb;
-        if (ca == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
-}
-
 static void test_scene(void **state)
 {
     (void)state;
@@ -459,7 +441,7 @@ static void test_scene(void **state)
         for (int i = 0; i < 2; i++) {
             snprintf(a, sizeof a, "%s/%s", dir, files[i]);
             snprintf(b, sizeof b, "scenes/gem/%s", files[i]);
-            if (!same_bytes(a, src_path(b)))
+            if (!files_equal(a, src_path(b)))
                 fail_msg("%s differs from the committed %s: run tools/make_gem.py", a, b);
         }
     }

@@ -59,23 +59,6 @@ static int merge(char **log, const char *out, const char *const *parts)
     return run_murk_argv(log, args);
 }
 
-static int same_file(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa && fb;
-    while (same) {
-        int x = fgetc(fa), y = fgetc(fb);
-        same = x == y;
-        if (x == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
-}
-
 static void merged_parts_are_the_whole_image(void **state)
 {
     (void)state;
@@ -87,7 +70,7 @@ static void merged_parts_are_the_whole_image(void **state)
         fail_msg("murk merge failed (%d):\n%s", rc, log);
     free(log);
     assert_same_pixels(tmp_path("merged.exr"), tmp_path("whole.exr"));
-    assert_true(same_file(tmp_path("merged.png"), tmp_path("whole.png")));
+    assert_true(files_equal(tmp_path("merged.png"), tmp_path("whole.png")));
     /* a part holds its tiles only: not the whole image */
     murk_image img = {0};
     char err[1024];

@@ -34,6 +34,8 @@ int run_murk(char **out, const char *arg0, ...);
 const char *tmp_dir(void);
 /* tmp_dir()/name (static buffer rotated 8 ways with src_path's and build_path's). */
 const char *tmp_path(const char *name);
+/* 1 if the files at a and b both open and hold the same bytes. */
+int files_equal(const char *a, const char *b);
 /* Writes text to tmp_dir()/name and returns its path. */
 const char *write_tmp(const char *name, const char *text);
 

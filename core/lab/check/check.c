@@ -744,8 +744,8 @@ static long sweep_count(const ck *c, const ck_set *set) { return c->quick ? (set
  * [0, 1] can have): above CK_VAR_FACTOR times it FAILs; and the largest sample's share of the sum of
  * squares (about ln(n) / n for a light tail; near 1 when one sample carries the estimate): above
  * CK_TAIL_SHARE it WARNs (spectral tracking's `max` and `average` probabilities, whose weights grow in
- * chromatic media as Kutz et al. 2017 say, reach 0.08 at a variance 5x). murk's own trackers and
- * estimators stay below 7x (docs/plugins.md gives the figures). */
+ * chromatic media as Kutz et al. 2017 say, do). docs/plugins.md gives the figures of murk's own trackers
+ * and estimators against these bounds. */
 #define CK_VAR_FACTOR 20.0
 #define CK_TAIL_SHARE 0.05
 static void tail(ck *c, const char *label, const char *what, const acc3 *a, long n, const double mu[3])
