@@ -585,14 +585,14 @@ static void test_textures(void **state)
     char quad_obj[512];
     snprintf(quad_obj, sizeof quad_obj, "%s", write_tmp("quad.obj", "v -0.5 0.25 0.5\nv 0.5 0.25 0.5\nv 0.5 0.25 -0.5\n"
                                                         "v -0.5 0.25 -0.5\nf 1 2 3\nf 1 3 4\n"));
+    const char *em = "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], "
+                     "\"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 0.5, 0.25], \"extensions\": "
+                     "{\"KHR_materials_emissive_strength\": {\"emissiveStrength\": 4}}}";
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }",
+             write_quad("strength.gltf", em, "\"extensionsUsed\": [\"KHR_materials_emissive_strength\"]", NULL));
+    a = render_scene(shape, NULL, NULL, NULL, "strength_gltf.exr");
+    snprintf(keep_a, sizeof keep_a, "%s", a);
     for (int k = 0; k < 2; k++) {
-        const char *em = "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], "
-                         "\"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 0.5, 0.25], \"extensions\": "
-                         "{\"KHR_materials_emissive_strength\": {\"emissiveStrength\": 4}}}";
-        snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }",
-                 write_quad("strength.gltf", em, "\"extensionsUsed\": [\"KHR_materials_emissive_strength\"]", NULL));
-        a = render_scene(shape, NULL, NULL, NULL, "strength_gltf.exr");
-        snprintf(keep_a, sizeof keep_a, "%s", a);
         snprintf(mats, sizeof mats, "  lamp: { type: ggx, albedo: [0.8, 0.8, 0.8], specular: 0.04, roughness: 1 }\n");
         snprintf(shape, sizeof shape, "{ type: mesh, file: %s, material: lamp, emission: %s }", quad_obj,
                  k ? "[1, 0.5, 0.25]" : "[4, 2, 1]");

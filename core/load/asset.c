@@ -9,7 +9,8 @@
  * one made from its material in the file (below); without a material the meshes are index-matched medium
  * boundaries (interior required), as a mesh shape's. `emission` makes every mesh emissive; with from_file
  * and no emission, a material's emissive factor does (times its emissive intensity where Assimp reads one:
- * Debian's Assimp 5.2.5 does not read glTF's KHR_materials_emissive_strength, so a glTF emitter is at most 1).
+ * Debian's Assimp 5.2.5 drops glTF's KHR_materials_emissive_strength: murk reads it from the JSON itself,
+ * emissive_strengths below, and matches it to Assimp's materials by name).
  *
  * Materials (from_file): murk's ggx (plugins/materials/ggx.c), from glTF's metallic-roughness model the
  * way the glTF specification mixes its dielectric and metal BRDFs (Appendix B, "fresnel_mix"):
@@ -18,7 +19,10 @@
  * A file without metallic-roughness (OBJ's .mtl, FBX's Phong, PLY's default) maps its diffuse colour to
  * albedo, its specular colour (averaged, clamped to [0, 1]) to specular and its Phong exponent n to
  * roughness = (2 / (n + 2))^(1/4) (Walter et al. 2007's alpha = sqrt(2 / (n + 2)) for Blinn-Phong).
- * Textures in the file are not read: the factor alone is used, and murk says so once per file.
+ * Textures (file_texture): glTF's base colour (sRGB), metallicRoughness (linear; G roughness, B metallic) and
+ * emissive textures, other formats' diffuse map, read as murk's image textures (PNG beside the file, or
+ * embedded in a .glb) and mixed per hit by the formulas above (scene/texture.c's murk_texture_gltf); an
+ * emissive texture is the mesh's emission_tex (render/host.c, render/lights.c). README, Assets.
  *
  * Lights (lights: true): KHR_lights_punctual's point, spot and directional lights become murk's point, spot
  * and distant lights (render/lights.h), placed by their nodes; intensity = colour x intensity x
