@@ -772,6 +772,23 @@ static int take_camera(asset_ctx *a, const char *want, murk_asset_camera *cam, c
                    c->mName.data, (double)cam->fov);
     return 0;
 }
+
+/* 1 if the PLY file at path has a line "end_header": Debian's Assimp 5.2.5 reads a header without one forever
+ * (found by tests/fuzz: fuzz_asset; the seed corpus keeps the input, ply_no_end_header). */
+static int ply_header_ends(const char *path)
+{
+    uint64_t size;
+    char ferr[512];
+    unsigned char *b = murk_file_read_all(path, &size, ferr, sizeof ferr);
+    if (!b)
+        return 1; /* Assimp's own open reports it */
+    int found = 0;
+    for (uint64_t i = 0; !found && i + 10 <= size; i++)
+        found = (i == 0 || b[i - 1] == '\n') && !memcmp(b + i, "end_header", 10) &&
+                (i + 10 == size || b[i + 10] == '\n' || b[i + 10] == '\r');
+    free(b);
+    return found;
+}
 #endif
 
 /* ---- the block ------------------------------------------------------------------------------------------ */
@@ -847,6 +864,11 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
         if (bytes)
             a.strength = emissive_strengths(bytes, (size_t)size, &a.nstrength);
         free(bytes);
+    }
+    if (ends_with(file, ".ply") && !ply_header_ends(path)) {
+        free(path);
+        free(a.strength);
+        return ERR(f, "asset: %s: its PLY header has no 'end_header' line (Assimp 5.2 would read on without end)", file);
     }
     struct aiPropertyStore *props = aiCreatePropertyStore();
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
