@@ -793,7 +793,14 @@ static void test_vdb_memory(void **state)
            peak0 / 1048576.0, (peak - peak0) / 1048576.0, (peak - peak0) / floats);
     assert_true(active / box > 0.029 && active / box < 0.031);
     assert_true(grid <= 1.5 * floats);
-    assert_true(peak - peak0 <= 1.5 * floats);
+    /* The process's resident memory says what murk holds only without a sanitizer: AddressSanitizer adds
+       shadow memory and a quarantine of freed blocks to every allocation. The grid's own count above still
+       holds there. */
+    const char *san = getenv("MURK_B_SANITIZE");
+    if (san && *san && strcmp(san, "none") != 0)
+        printf("built with -fsanitize=%s: the peak resident memory is not judged\n", san);
+    else
+        assert_true(peak - peak0 <= 1.5 * floats);
     remove(big);
 }
 
