@@ -346,7 +346,7 @@ static void test_builder_errors(void **state)
         v[i] = 0.25f;
     int amin[3] = {0, 0, 0}, amax[3] = {15, 7, 7}, o[3] = {8, 0, 0}, same[3] = {0, 0, 0}, out[3] = {16, 0, 0};
     v[3 * 64 + 2 * 8 + 5] = -2.0f;
-    expect_build_error(amin, amax, o, v, 0, "negative density -2 at voxel (11, 2, 5)");
+    expect_build_error(amin, amax, o, v, 0, "negative value -2 at voxel (11, 2, 5)");
     v[3 * 64 + 2 * 8 + 5] = NAN;
     expect_build_error(amin, amax, o, v, 0, "invalid value");
     v[3 * 64 + 2 * 8 + 5] = 0.25f;
@@ -459,7 +459,7 @@ static void test_vdb_grids(void **state)
     expect_vdb_error(vdb_file("frustum.vdb", "grid density float\nfrustum\nvoxel 1 1 1 2\n"), NULL, "non-linear");
     expect_vdb_error(vdb_file("empty.vdb", "grid density float\n"), NULL, "has no active voxels");
     expect_vdb_error(vdb_file("negative.vdb", "grid density float\nvoxel 1 2 3 -0.5\n"), NULL,
-                     "negative density -0.5 at voxel (1, 2, 3)");
+                     "negative value -0.5 at voxel (1, 2, 3)");
     /* a truncated file, random bytes, a directory, a missing file */
     const char *tr = tmp_path("truncated.vdb");
     FILE *in = fopen(p, "rb"), *out = fopen(tr, "wb");
