@@ -334,7 +334,7 @@ static void test_vol_errors(void **state)
     vol_expect("trailing.vol", c, n + 4, "after the data");
     memcpy(c, b, n);
     putf(c + 48 + 4 * 7, -0.25f);
-    vol_expect("negative.vol", c, n, "negative density");
+    vol_expect("negative.vol", c, n, "negative value");
     memcpy(c, b, n);
     putf(c + 48 + 4 * 7, NAN);
     vol_expect("nan.vol", c, n, "invalid value");
@@ -1011,7 +1011,7 @@ static void test_nvdb(void **state)
     s.grid_class = 2;
     vals[17] = -2.0f;
     b = nv_write(&s, &n);
-    nv_expect("negative.nvdb", b, n, "negative density");
+    nv_expect("negative.nvdb", b, n, "negative value");
     free(b);
     vals[17] = 1.0f;
     const char *missing = tmp_file("missing.nvdb");

@@ -8,6 +8,9 @@ set -u
 h=$1 corpus=$2 max_len=$3
 secs=${MURK_FUZZ_SECONDS:-10}
 name=$(basename "$h")
+# Leaks inside third-party libraries murk cannot fix (each explained in lsan.supp) are not murk's.
+LSAN_OPTIONS="suppressions=$(cd "$(dirname "$0")" && pwd)/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+export LSAN_OPTIONS
 work=$(mktemp -d "${TMPDIR:-/tmp}/murk-fuzz-smoke.XXXXXX")
 log=$work/log
 # 1. replay: every seed once

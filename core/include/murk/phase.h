@@ -14,7 +14,7 @@
  * function as the `hg` plugin); `g` beside a `phase:` block is an error. Trackers never see the phase
  * function (they only sample distances); integrators reach it through the host: murk_host's
  * medium_phase_eval / medium_phase_sample take the medium (murk/plugin.h), and the older phase_eval /
- * phase_sample (g, ...) remain Henyey-Greenstein for plugins built before 1.7.
+ * phase_sample (g, ...) remain Henyey-Greenstein for plugins built before 1.9.
  *
  * Contracts (besides those of murk/plugin.h):
  *   create()  gets the phase function's own parameters (schema-checked, with located errors).
