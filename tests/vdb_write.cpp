@@ -8,7 +8,7 @@
  *                           index to world: scale, then rotate (degrees about x, y, z), then translate
  *   frustum                 a non-linear (frustum) transform
  *   background V
- *   voxel X Y Z V           an active voxel
+ *   voxel X Y Z V           an active voxel (V may be nan or inf, to write bad files)
  *   inactive X Y Z V        a voxel holding V, inactive
  *   fill X0 Y0 Z0 X1 Y1 Z1 V    active V over the inclusive box (OpenVDB makes tiles where it can)
  *   vol FILE                the voxels of a Mitsuba .vol (1 channel float32): voxel (x, y, z) at index (x, y, z),
@@ -28,6 +28,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -232,8 +233,12 @@ int main(int argc, char **argv)
                 g.d->tree().root().setBackground(v, true);
         } else if (cmd == "voxel" || cmd == "inactive") {
             int x, y, z;
-            double v;
-            in >> x >> y >> z >> v;
+            std::string word;
+            in >> x >> y >> z >> word;
+            char *end = nullptr;
+            double v = std::strtod(word.c_str(), &end); /* strtod: also nan and inf, which >> refuses */
+            if (word.empty() || *end)
+                die("not a number: " + word);
             set(g, Coord(x, y, z), v, cmd == "voxel");
         } else if (cmd == "fill") {
             int b[6];

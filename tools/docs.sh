@@ -129,6 +129,16 @@ part_bench() {
   bench c_spectral_extinction scenes/spectral_extinction.yaml --vary integrator.type=volpath,volpath_nee \
     --vary media.medium.type=naive_spectral,spectral,spectral_mis --set "$R64" --time 2,6 --ref-spp 2048 \
     --ref-set media.medium.type=spectral_mis
+  bench g2_spectral_fog_large_light scenes/spectral_fog_large_light.yaml \
+    --vary media.fog.type=naive_spectral,spectral,spectral_mis --set "$R64" --spp 16,64 --ref-spp 2048 \
+    --ref-set media.fog.type=spectral_mis
+  bench g2b_spectral_fog_large_light_nee_mis scenes/spectral_fog_large_light.yaml \
+    --vary integrator.nee_mis=solid_angle,null_scattering --vary media.fog.transmittance=residual_ratio,ratio \
+    --set "$R64" --spp 16,64 --ref-spp 2048 --ref-set media.fog.type=spectral_mis
+  bench g2c_spectral_fog_sky_nee_mis scenes/spectral_fog_sky.yaml --vary integrator.nee_mis=solid_angle,null_scattering \
+    --set media.fog.transmittance=ratio --set "$R64" --spp 16,64 --ref-spp 1024 --ref-set media.fog.type=spectral_mis
+  bench g2d_spectral_fog_sky scenes/spectral_fog_sky.yaml --vary media.fog.type=naive_spectral,spectral,spectral_mis \
+    --set media.fog.transmittance=ratio --set "$R64" --spp 16,64 --ref-spp 1024 --ref-set media.fog.type=spectral_mis
   bench d_dense_cloud scenes/dense_cloud.yaml --vary media.cloud.type=delta,spectral,decomposition --set "$R64" \
     --time 2,6 --ref-spp 1024
   bench d2_dense_cloud_resolution scenes/dense_cloud.yaml --vary media.cloud.type=delta,decomposition \

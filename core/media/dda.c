@@ -58,8 +58,8 @@ void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, fl
             ta = tb;
             tb = t;
         }
-        tin = fmax(tin, ta);
-        tout = fmin(tout, tb);
+        tin = murk_fmax(tin, ta);
+        tout = murk_fmin(tout, tb);
     }
     /* t0 <= tin and tout <= t1 in double, so also after rounding to float (t0, t1 are floats). */
     float fin = (float)tin, fout = (float)tout;

@@ -88,7 +88,7 @@ static int check_values(const char *path, const float *data, const int res[3], c
                 float v = data[i];
                 if (isfinite(v) && v >= 0.0f)
                     continue;
-                murk_err_file(err, errlen, path, "%s %g at voxel (%d, %d, %d); densities must be finite and >= 0", isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative density"), (double)v, x + origin[0], y + origin[1], z + origin[2]);
+                murk_err_file(err, errlen, path, "%s %g at voxel (%d, %d, %d); field values must be finite and >= 0", isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative value"), (double)v, x + origin[0], y + origin[1], z + origin[2]);
                 return -1;
             }
     return 0;

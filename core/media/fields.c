@@ -29,22 +29,29 @@ static murk_rgb field3_eval(const murk_field3 *f, murk_vec3 p)
     return murk_rgb3(r, murk_field_eval(f->ch[1], p), murk_field_eval(f->ch[2], p));
 }
 
-/* A grid field's first voxel above hi, reported at node n (albedo above 1). */
+/* A grid field's first voxel above hi, reported at node n (albedo above 1). Voxels are counted in the grid's
+ * box: a .vol's own voxel indices; for a sparse grid (.vdb, .nvdb) the box starts one voxel below its active
+ * voxels' index box (density.h), so that is said. */
 static int check_max(const murk_field3 *f, const murk_ynode *n, const char *what, double hi, char *err, size_t errlen)
 {
     for (int k = 0; k < 3; k++) {
         if (!f->ch[k] || !(murk_field_max(f->ch[k]) > hi))
             continue;
         int res[3];
-        const float *d;
-        murk_field_grid(f->ch[k], res, &d);
-        size_t i = 0;
-        while (d && !(d[i] > hi))
-            i++;
-        long x = (long)(i % (size_t)res[0]), y = (long)(i / (size_t)res[0] % (size_t)res[1]);
-        long z = (long)(i / ((size_t)res[0] * (size_t)res[1]));
-        return murk_yerr(err, errlen, n, "%s: value %g at voxel (%ld, %ld, %ld)%s is above %g", what,
-                         (double)murk_field_max(f->ch[k]), x, y, z, f->ch[1] != f->ch[0] ? (k == 0 ? " (red)" : k == 1 ? " (green)" : " (blue)") : "", hi);
+        murk_field_grid(f->ch[k], res, NULL);
+        long x = 0, y = 0, z = 0;
+        float v = murk_field_max(f->ch[k]);
+        for (z = 0; z < res[2]; z++)
+            for (y = 0; y < res[1]; y++)
+                for (x = 0; x < res[0]; x++)
+                    if ((v = murk_field_voxel(f->ch[k], (int)x, (int)y, (int)z)) > hi)
+                        goto found;
+    found:;
+        murk_field_info fi;
+        murk_field_describe(f->ch[k], &fi);
+        return murk_yerr(err, errlen, n, "%s: value %g at voxel (%ld, %ld, %ld)%s%s is above %g", what, (double)v,
+                         x, y, z, fi.sparse ? " of the grid's box" : "",
+                         f->ch[1] != f->ch[0] ? (k == 0 ? " (red)" : k == 1 ? " (green)" : " (blue)") : "", hi);
     }
     return 0;
 }

@@ -3,14 +3,18 @@
  * has what they mean to trackers). Internal to core/media (fields.c; media.c holds one per medium).
  *
  *   albedo: [r, g, b] | V | { constant: V|[r,g,b] }   folded into sigma_s and sigma_a at load (no field)
- *   albedo: { grid: F.vol } | { grid: F.nvdb } | { cloud: {...} }   a field: a(p) per channel
- *   emission: [r, g, b] | V | { constant: ... } | { grid: ... } | { cloud: ... }   Le(p), per unit absorption
- *   temperature: { grid: ... } | { constant: V } | { cloud: {...} }   T(p) = (value - offset) x scale kelvin
+ *   albedo: { grid: F.vol } | { grid: F.nvdb } | { vdb: F.vdb, grid: NAME } | { cloud: {...} }   a field: a(p)
+ *   emission: [r, g, b] | V | { constant: ... } | { grid: ... } | { vdb: ... } | { cloud: ... }   Le(p), per unit
+ *             absorption
+ *   temperature: { grid: ... } | { vdb: ... } | { constant: V } | { cloud: {...} }   T(p) = (value - offset) x
+ *             scale kelvin
  *
  * Le(p) = emission(p) x blackbody(T(p)) per channel, where a missing `emission` is 1 when the medium has a
  * temperature and a missing temperature leaves emission(p) alone. Grids: .vol of 1 channel (grey) or 3
- * (RGB), NanoVDB's first float grid (grey). Each field has its own box (values 0 outside it), whatever
- * the density's: boxes and resolutions may differ. */
+ * (RGB), NanoVDB's first float grid (grey), an OpenVDB file's named float, half or double grid (grey: murk
+ * reads scalar grids only, so a vec3s grid is refused and an RGB albedo comes from a 3-channel .vol). All
+ * go through source.c, so every field's values are finite and >= 0 (a located error otherwise). Each field
+ * has its own box (values 0 outside it), whatever the density's: boxes and resolutions may differ. */
 #ifndef MURK_FIELDS_H
 #define MURK_FIELDS_H
 

@@ -293,8 +293,8 @@ static int too_many(murk_sparse_build *b, uint64_t more, char *err, size_t errle
 
 static int bad_value(murk_sparse_build *b, float v, const int origin[3], int i, char *err, size_t errlen)
 {
-    return murk_err_file(err, errlen, b->path, "%s %g at voxel (%d, %d, %d); densities must be finite and >= 0",
-                         isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative density"), (double)v,
+    return murk_err_file(err, errlen, b->path, "%s %g at voxel (%d, %d, %d); field values must be finite and >= 0",
+                         isnan(v) ? "invalid value" : (isinf(v) ? "infinite value" : "negative value"), (double)v,
                          origin[0] + (i >> 6), origin[1] + ((i >> 3) & 7), origin[2] + (i & 7));
 }
 
@@ -334,9 +334,9 @@ int murk_sparse_leaf(murk_sparse_build *b, const int origin[3], const float *val
 int murk_sparse_tile(murk_sparse_build *b, const int origin[3], long long dim, float value, char *err, size_t errlen)
 {
     if (!(isfinite(value) && value >= 0.0f)) {
-        return murk_err_file(err, errlen, b->path, "%s %g in the tile at index (%d, %d, %d); densities must be finite "
+        return murk_err_file(err, errlen, b->path, "%s %g in the tile at index (%d, %d, %d); field values must be finite "
                              "and >= 0", isnan(value) ? "invalid value" : (isinf(value) ? "infinite value" :
-                             "negative density"), (double)value, origin[0], origin[1], origin[2]);
+                             "negative value"), (double)value, origin[0], origin[1], origin[2]);
     }
     int lo[3], hi[3]; /* the table bricks the tile covers */
     uint64_t voxels = 1;

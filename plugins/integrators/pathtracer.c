@@ -324,6 +324,19 @@ typedef struct vertex {
     const murk_medium *behind; /* the medium on the far side of the surface from wo */
 } vertex;
 
+/* A scattering vertex in medium m at p: only what a medium's vertex uses is set (a surface's frame and
+ * shading point stay unset; the phase function needs none of them), so no memset per scattering event. */
+static void medium_point(vertex *v, murk_vec3 p, murk_vec3 wo, const murk_medium *m)
+{
+    v->p = p;
+    v->offset_n = murk_v3(0, 0, 0);
+    v->wo = wo;
+    v->mat = NULL;
+    v->sp = NULL;
+    v->medium = m;
+    v->behind = NULL;
+}
+
 /* 1 if the shading frame and the geometry agree on the side of the surface wi lies on (wo's side:
  * reflection; the other: transmission), so no light leaks through a surface because its shading normal
  * says so. */
@@ -394,7 +407,8 @@ static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, p
         return T;
     if (ls->flags & MURK_LIGHT_SAMPLE_DELTA) /* no BSDF or phase sample can hit a delta light: weight 1 */
         return murk_rgb_scale(murk_rgb_mul(murk_rgb_mul(f, T), ls->le), 1.0f / ls->pdf);
-    float pdf = vertex_pdf(h, v, ls->wi);
+    /* in a medium the pdf is the phase function's value, which f already holds: one plugin call, not two */
+    float pdf = v->mat ? vertex_pdf(h, v, ls->wi) : f.c[0];
     if (!isfinite(pdf)) {
         broken(h, "material", v->mat ? v->mat->name : "(phase)", "pdf");
         return murk_rgb1(0.0f);
@@ -518,10 +532,8 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     }
     if (murk_rgb_is_black(T))
         return;
-    vertex v = {0};
-    v.p = x;
-    v.wo = murk_neg(st->ray.d);
-    v.medium = m;
+    vertex v;
+    medium_point(&v, x, murk_neg(st->ray.d), m);
     path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
     at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
     at.L = murk_rgb1(0.0f);
@@ -575,10 +587,8 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     }
     if (st->depth >= pt->max_depth)
         return PT_TAP_END(st, MURK_PT_END_MAX_DEPTH), PT_END;
-    vertex v = {0};
-    v.p = murk_madd(st->ray.o, st->ray.d, ev.t);
-    v.wo = murk_neg(st->ray.d);
-    v.medium = m;
+    vertex v;
+    medium_point(&v, murk_madd(st->ray.o, st->ray.d, ev.t), murk_neg(st->ray.d), m);
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
         sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t),
                      MURK_PT_TERM_MEDIUM_NEE, rng);
@@ -642,10 +652,11 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
                                                                                  : MURK_PT_TERM_BSDF_EMISSION);
     if (st->depth >= pt->max_depth)
         return PT_TAP_END(st, MURK_PT_END_MAX_DEPTH), 0;
-    vertex v = {0};
+    vertex v; /* every field is set below */
     v.p = hit->p;
     v.wo = wo;
     v.mat = hit->material;
+    v.medium = NULL;
     murk_hit mh = *hit; /* the material's copy: n on wo's side */
     murk_shading sp;
     v.sp = &sp;

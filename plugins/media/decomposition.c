@@ -67,8 +67,8 @@ static void decomposition_rates(const decomposition *m, float dmax, float dmin, 
 
 /* A process's next optical depth -ln(1 - u): what *carried holds (from an earlier cell; then -1), else a
  * new number (the slot's while *first). *keep gets the depth when it is one to carry on at the cell's end
- * (the slot's first number with sobol, or a carried one), else 0. */
-static float decomposition_depth(murk_rng *rng, int *first, float *uc, float *carried, float *keep)
+ * (the slot's first number with sobol, or a carried one), else 0. Inlined: it runs at every tentative collision. */
+static MURK_ALWAYS_INLINE float decomposition_depth(murk_rng *rng, int *first, float *uc, float *carried, float *keep)
 {
     float tau;
     int carry = *carried >= 0.0f;

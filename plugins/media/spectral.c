@@ -38,7 +38,7 @@ static int spectral_create(const murk_host *host, const murk_medium_data *data, 
 static float pick(int scheme, const float x[3], const float w[3])
 {
     if (scheme == PROB_MAX)
-        return fmaxf(fabsf(x[0]), fmaxf(fabsf(x[1]), fabsf(x[2])));
+        return murk_fmaxf(fabsf(x[0]), murk_fmaxf(fabsf(x[1]), fabsf(x[2])));
     if (scheme == PROB_AVERAGE)
         return (fabsf(x[0]) + fabsf(x[1]) + fabsf(x[2])) / 3.0f;
     return (fabsf(w[0] * x[0]) + fabsf(w[1] * x[1]) + fabsf(w[2] * x[2])) / 3.0f;

@@ -22,6 +22,14 @@ typedef struct murk_ray {
  * ignored). If b is NaN the result is NaN, so NaNs still reach the film's non-finite check. */
 static inline float murk_maxf(float a, float b) { return a > b ? a : b; }
 static inline float murk_minf(float a, float b) { return a < b ? a : b; }
+/* fmaxf, fminf, fmax and fmin as C99 defines them (a quiet NaN argument yields the other one), with the very
+ * results of glibc's x86-64 versions (of two equal numbers, such as -0 and +0, b), inlined: gcc calls libm
+ * for them unless NaNs and signed zeros may be ignored, and the hot loops that use them (ratio tracking,
+ * the majorant walk, phase functions) should make no call per step. */
+static inline float murk_fmaxf(float a, float b) { return a > b || isnan(b) ? a : b; }
+static inline float murk_fminf(float a, float b) { return a < b || isnan(b) ? a : b; }
+static inline double murk_fmax(double a, double b) { return a > b || isnan(b) ? a : b; }
+static inline double murk_fmin(double a, double b) { return a < b || isnan(b) ? a : b; }
 
 static inline murk_vec3 murk_v3(float x, float y, float z) { murk_vec3 v = {x, y, z}; return v; }
 static inline murk_vec3 murk_add(murk_vec3 a, murk_vec3 b) { return murk_v3(a.x + b.x, a.y + b.y, a.z + b.z); }

@@ -14,7 +14,7 @@
  * function as the `hg` plugin); `g` beside a `phase:` block is an error. Trackers never see the phase
  * function (they only sample distances); integrators reach it through the host: murk_host's
  * medium_phase_eval / medium_phase_sample take the medium (murk/plugin.h), and the older phase_eval /
- * phase_sample (g, ...) remain Henyey-Greenstein for plugins built before 1.7.
+ * phase_sample (g, ...) remain Henyey-Greenstein for plugins built before 1.9.
  *
  * Contracts (besides those of murk/plugin.h):
  *   create()  gets the phase function's own parameters (schema-checked, with located errors).
@@ -63,14 +63,14 @@ static inline float murk_hg_eval(float g, murk_vec3 wo, murk_vec3 wi)
 {
     float cost = murk_dot(wo, wi);
     float denom = 1.0f + g * g + 2.0f * g * cost;
-    return (1.0f / (4.0f * MURK_PI)) * (1.0f - g * g) / (denom * sqrtf(fmaxf(denom, 1e-12f)));
+    return (1.0f / (4.0f * MURK_PI)) * (1.0f - g * g) / (denom * sqrtf(murk_fmaxf(denom, 1e-12f)));
 }
 
 /* The direction with cos(angle to axis) = cost and azimuth 2 pi u1 about the unit axis. */
 static inline murk_vec3 murk_phase_dir(murk_vec3 axis, float cost, float u1)
 {
-    cost = fminf(1.0f, fmaxf(-1.0f, cost));
-    float sint = sqrtf(fmaxf(0.0f, 1.0f - cost * cost)), phi = 2.0f * MURK_PI * u1;
+    cost = murk_fminf(1.0f, murk_fmaxf(-1.0f, cost));
+    float sint = sqrtf(murk_fmaxf(0.0f, 1.0f - cost * cost)), phi = 2.0f * MURK_PI * u1;
     murk_vec3 t, b;
     murk_basis(axis, &t, &b);
     return murk_normalize(murk_from_local(murk_v3(sint * cosf(phi), sint * sinf(phi), cost), t, b, axis));
@@ -80,7 +80,7 @@ static inline murk_vec3 murk_phase_dir(murk_vec3 axis, float cost, float u1)
  * om rather than cos(theta), so that directions within 1e-3 radians of the axis keep their precision. */
 static inline murk_vec3 murk_phase_dir_om(murk_vec3 axis, float om, float u1)
 {
-    om = fminf(2.0f, fmaxf(0.0f, om));
+    om = murk_fminf(2.0f, murk_fmaxf(0.0f, om));
     float sint = sqrtf(om * (2.0f - om)), phi = 2.0f * MURK_PI * u1;
     murk_vec3 t, b;
     murk_basis(axis, &t, &b);

@@ -165,20 +165,21 @@ typedef struct murk_hit {
 
 typedef struct murk_light_sample {
     murk_vec3 wi;  /* unit direction from the shading point to the light point */
-    float dist;    /* distance to the light point; INFINITY (ABI 1.7) for a light at infinity (a distant
+    float dist;    /* distance to the light point; INFINITY (ABI 1.8) for a light at infinity (a distant
                     * light, the environment): the shadow ray runs to infinity along wi */
     murk_rgb le;   /* emitted radiance towards the shading point (a delta light: its irradiance there) */
     float pdf;     /* solid-angle pdf, light selection included; 0 = no sample (a delta light: the
                     * probability of choosing it) */
-    /* ABI 1.7: MURK_LIGHT_SAMPLE_* bits. The host writes it only for integrators of ABI >= 1.7 (older
+    /* ABI 1.8: MURK_LIGHT_SAMPLE_* bits. The host writes it only for integrators of ABI >= 1.8 (older
      * ones never get a delta or infinite sample): an integrator sets it to 0 before asking. */
     uint32_t flags;
 } murk_light_sample;
 
-/* murk_light_sample.flags (ABI 1.7). DELTA: a point, spot or delta distant light, which no BSDF or
+/* murk_light_sample.flags (ABI 1.8). DELTA: a point, spot or delta distant light, which no BSDF or
  * phase sample can hit: f le T / pdf counts with MIS weight 1. */
 #define MURK_LIGHT_SAMPLE_DELTA 1u
-/* The size of murk_light_sample before ABI 1.7 (what an older integrator's stack holds). */
+/* The size of murk_light_sample before ABI 1.8, of 1.0 to 1.7 (what an older integrator's stack holds; the
+ * name is older than the minor's number, which became 1.8 when 1.7 went to prepared materials). */
 #define MURK_LIGHT_SAMPLE_SIZE_1_6 (offsetof(murk_light_sample, pdf) + sizeof(float))
 
 /* ---- Host services (the only way a plugin reaches the core) -------------------------------- */
@@ -196,7 +197,7 @@ typedef struct murk_host {
      * (ray.tmin, ray.tmax); occluded() returns 1 if any surface lies there (boundaries included). */
     int (*intersect)(const murk_scene *scene, const murk_ray *ray, murk_hit *hit);
     int (*occluded)(const murk_scene *scene, const murk_ray *ray);
-    /* Pick a light (by power: emissive shapes and, for integrators of ABI >= 1.7, the scene's `lights:`)
+    /* Pick a light (by power: emissive shapes and, for integrators of ABI >= 1.8, the scene's `lights:`)
      * and a point on it as seen from p; u are three uniforms. */
     int (*sample_light)(const murk_scene *scene, murk_vec3 p, const float u[3], murk_light_sample *ls);
     /* The solid-angle pdf with which sample_light(p) would have produced the emissive hit. */
@@ -228,7 +229,7 @@ typedef struct murk_host {
      * every surface occluded() can find has a material: a shadow ray it reports blocked is blocked,
      * with no intersect() to tell a boundary from an occluder. */
     size_t (*boundaries)(const murk_scene *scene);
-    /* ABI 1.7: the solid-angle pdf with which sample_light_with would have sampled direction dir of the
+    /* ABI 1.8: the solid-angle pdf with which sample_light_with would have sampled direction dir of the
      * environment (background(), which holds the whole environment: the constant background, environment
      * maps, the sky, finite-cone distant lights). 0 where no part of it is sampled (a scene with only a
      * constant background: escaped rays count fully, as before). An escaped ray after a BSDF / phase

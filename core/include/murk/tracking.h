@@ -273,8 +273,8 @@ static inline void murk_collisions_raise(murk_collisions *c, float amax)
 {
     if (!(amax > 1.0f))
         return;
-    float f = fminf(MURK_MAJORANT_RAISE * amax, 1e6f);
-    c->boost = fminf(c->boost * f, 1e12f);
+    float f = murk_fminf(MURK_MAJORANT_RAISE * amax, 1e6f);
+    c->boost = murk_fminf(c->boost * f, 1e12f);
     c->mu *= f;
 }
 
@@ -300,7 +300,7 @@ static MURK_ALWAYS_INLINE int murk_collisions_next(murk_collisions *c, murk_rng 
                 tau = -log1pf(-murk_flight_float(rng, &c->first, &c->uc));
             }
             c->t = murk_advance(c->t, tau / c->mu);
-            c->tau = carry && !(c->t < c->tb) ? fmaxf(0.0f, tau - c->mu * (c->tb - t0)) : -1.0f;
+            c->tau = carry && !(c->t < c->tb) ? murk_fmaxf(0.0f, tau - c->mu * (c->tb - t0)) : -1.0f;
             if (c->t < c->tb) {
                 c->count->collisions++;
                 *t = c->t;
@@ -418,7 +418,7 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
         /* residual majorant; any positive value keeps ratio tracking unbiased, so a control above the
          * majorant only costs variance; where |density - control| x sigma exceeds it the rest of the ray
          * is tracked with it raised (unbiased for the reason given above murk_collisions_raise) */
-        float mu = fmaxf(fabsf(dmax - c), 1e-3f * fmaxf(dmax, c)) * smax * boost;
+        float mu = murk_fmaxf(fabsf(dmax - c), 1e-3f * murk_fmaxf(dmax, c)) * smax * boost;
         if (!(mu > 0.0f))
             continue;
         for (float t = ta;;) {
@@ -431,11 +431,11 @@ static inline murk_rgb murk_ratio_tracking(const murk_host *h, const murk_medium
             for (int k = 0; k < 3; k++)
                 T.c[k] *= 1.0f - dens * st.c[k] / mu;
             if (r > 1.0f) { /* the majorant failed (|factor| may exceed 1): raise it for the rest of the ray */
-                float f = fminf(MURK_MAJORANT_RAISE * r, 1e6f);
-                boost = fminf(boost * f, 1e12f);
+                float f = murk_fminf(MURK_MAJORANT_RAISE * r, 1e6f);
+                boost = murk_fminf(boost * f, 1e12f);
                 mu *= f;
             }
-            float tm = fmaxf(fabsf(T.c[0]), fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
+            float tm = murk_fmaxf(fabsf(T.c[0]), murk_fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
             if (tm < 0.1f) {
                 if (tm <= 0.0f || murk_rng_float(rng) >= tm)
                     return murk_rgb1(0.0f);
@@ -485,7 +485,7 @@ static inline murk_rgb murk_ratio_tracking_null(const murk_host *h, const murk_m
                 T.c[k] *= 1.0f - a;
                 P.c[k] *= 1.0f - murk_real_prob(a, 1.0f - a);
             }
-            float tm = fmaxf(fabsf(T.c[0]), fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
+            float tm = murk_fmaxf(fabsf(T.c[0]), murk_fmaxf(fabsf(T.c[1]), fabsf(T.c[2])));
             if (tm < 0.1f) { /* Russian roulette on the estimate only */
                 if (tm <= 0.0f || murk_rng_float(rng) >= tm) {
                     *pnull = P;
