@@ -872,24 +872,28 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
     }
     struct aiPropertyStore *props = aiCreatePropertyStore();
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    /* imported first without post-processing: a face without vertices (a PLY face list of 0) makes Debian's
-     * Assimp 5.2 abort in its Triangulate step (an ai_assert, found by tests/fuzz: seed ply_empty_face) */
-    a.ai = aiImportFileExWithProperties(path, 0, NULL, props);
-    aiReleasePropertyStore(props);
-    a.path = path;
+    /* read first without post-processing, to refuse a face without vertices (a PLY face list of 0), on which
+     * Debian's Assimp 5.2 aborts in its Triangulate step (an ai_assert; found by tests/fuzz, seed ply_empty_face);
+     * then read again with the steps. Not aiApplyPostProcessing on the first scene: when its validation fails
+     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release). */
+    const struct aiScene *probe = aiImportFileExWithProperties(path, 0, NULL, props);
     char bad[300] = "";
-    for (unsigned m = 0; a.ai && m < a.ai->mNumMeshes && !bad[0]; m++)
-        for (unsigned k = 0; a.ai->mMeshes[m] && a.ai->mMeshes[m]->mFaces && k < a.ai->mMeshes[m]->mNumFaces && !bad[0]; k++)
-            if (a.ai->mMeshes[m]->mFaces[k].mNumIndices == 0 || !a.ai->mMeshes[m]->mFaces[k].mIndices)
+    for (unsigned m = 0; probe && m < probe->mNumMeshes && !bad[0]; m++)
+        for (unsigned k = 0; probe->mMeshes[m] && probe->mMeshes[m]->mFaces && k < probe->mMeshes[m]->mNumFaces && !bad[0]; k++)
+            if (probe->mMeshes[m]->mFaces[k].mNumIndices == 0 || !probe->mMeshes[m]->mFaces[k].mIndices)
                 snprintf(bad, sizeof bad, "mesh %u face %u has no vertices", m, k);
+    if (probe)
+        aiReleaseImport(probe);
     if (bad[0]) {
-        aiReleaseImport(a.ai);
+        aiReleasePropertyStore(props);
         free(path);
         free(a.strength);
         return ERR(f, "asset: %s: %s", file, bad);
     }
-    if (a.ai)
-        a.ai = aiApplyPostProcessing(a.ai, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+    a.ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
+                                                aiProcess_ValidateDataStructure, NULL, props) : NULL;
+    aiReleasePropertyStore(props);
+    a.path = path;
     if (!a.ai) {
         char msg[512];
         free(path);
