@@ -16,11 +16,23 @@
  *   scene        tools/make_gem.py writes the bytes committed in scenes/gem/ (twice the same), and
  *                scenes/gem_asset.yaml (a PLY and a glTF with its materials, camera and spot lamp) renders a few
  *                spp with every pixel finite and >= 0.
- *   bad input    no mesh, a NaN vertex, a missing buffer, random bytes, truncated JSON, an unknown extension, a
- *                directory, from_asset naming a quad or an asset without a camera: `murk render` exits 1 with
- *                "scene.yaml:LINE:COL:" and writes no image. */
+ *   textures     a glTF quad with a base colour texture (external PNG; embedded in a .glb) renders bitwise as the
+ *                YAML quad with the same PNG as its ggx albedo (upside down in v must differ); a uniform
+ *                metallicRoughness texture times the factors as the mapped ggx (the mix left out must differ);
+ *                KHR_materials_emissive_strength 4 as the YAML emission x 4 (without it must differ).
+ *   uv origin    an emissive texture of four coloured quadrants seen straight down: each quadrant where glTF's
+ *                convention (texture coordinate (0, 0) at the image's top-left) puts it.
+ *   emission     an emissive texture half white, half black lights the room as its white half as an emissive
+ *                OBJ mesh (block-wise z over independent seeds, stat.h); the other half emitting must differ.
+ *   info lights  murk info lists the lights: block's spot and the glTF's point light, each with its origin.
+ *   bad texture  a glTF whose texture file is missing: a located error naming it, no image.
+ *   bad input    no mesh, a NaN vertex, a missing buffer, random bytes, truncated JSON, a PLY header without
+ *                end_header (Assimp 5.2 hangs on it), a face of no vertices (Assimp 5.2 aborts), an unknown
+ *                extension, a directory, from_asset naming a quad or an asset without a camera: `murk render`
+ *                exits 1 with "scene.yaml:LINE:COL:" and writes no image. */
 #include "testutil.h"
 #include "image/image.h"
+#include "stat.h"
 
 #ifdef MURK_HAVE_ASSIMP
 #include <assimp/cexport.h>
@@ -148,16 +160,15 @@ static const char *write_gltf(const char *name, const char *material, const char
     return write_tmp(name, text);
 }
 
-static const char *write_glb(const char *name)
+/* A binary glTF of the JSON text (room for 3 pad bytes after it) and the BIN chunk's nb bytes. */
+static const char *write_glb_chunks(const char *name, char *json, const unsigned char *bin, size_t nb)
 {
-    unsigned char bin[128], out[8192];
-    char json[4096];
-    size_t nb = mesh_buffer(bin, 0);
-    gltf_json(json, sizeof json, NULL, NULL, NULL, NULL, 1);
     size_t nj = strlen(json);
     while (nj % 4)
         json[nj++] = ' ';
     size_t total = 12 + 8 + nj + 8 + nb;
+    unsigned char *out = malloc(total);
+    assert_non_null(out);
     uint32_t h[3] = {0x46546C67u, 2, (uint32_t)total}, cj[2] = {(uint32_t)nj, 0x4E4F534Au}, cb[2] = {(uint32_t)nb, 0x004E4942u};
     memcpy(out, h, 12);
     memcpy(out + 12, cj, 8);
@@ -167,7 +178,17 @@ static const char *write_glb(const char *name)
     static char p[512];
     snprintf(p, sizeof p, "%s", tmp_path(name));
     write_file(p, out, total);
+    free(out);
     return p;
+}
+
+static const char *write_glb(const char *name)
+{
+    unsigned char bin[128];
+    char json[4096];
+    size_t nb = mesh_buffer(bin, 0);
+    gltf_json(json, sizeof json, NULL, NULL, NULL, NULL, 1);
+    return write_glb_chunks(name, json, bin, nb);
 }
 
 #ifdef MURK_HAVE_ASSIMP
@@ -188,18 +209,21 @@ static const char *write_fbx(const char *name, const char *obj)
 
 /* A small lit room around the mesh shape `shape` (a YAML flow map), with `camera` and `extra` (more top-level
  * YAML) if given; rendered at 32x32, 16 spp, seed 3 into tmp_dir()/out. */
+static int small_renders; /* 1: 16x16 at 4 spp (the bitwise comparisons of textures need no more) */
+
 static const char *render_scene(const char *shape, const char *materials, const char *camera, const char *extra,
                                 const char *out)
 {
     char text[4096];
     snprintf(text, sizeof text,
-             "murk: 1\nrender: { resolution: [32, 32], spp: 16, seed: 3 }\n"
+             "murk: 1\nrender: { resolution: %s, seed: 3 }\n"
              "camera: %s\n"
              "materials:\n  white: { type: diffuse, albedo: 0.7 }\n  shiny: { type: ggx, albedo: 0.5, specular: 0.3, roughness: 0.4 }\n%s"
              "%s"
              "shapes:\n  - { type: quad, center: [0, 0, 0], u: [2, 0, 0], v: [0, 0, -2], material: white }\n"
              "  - { type: quad, center: [0, 2, 0], u: [0.3, 0, 0], v: [0, 0, 0.3], material: shiny, emission: [12, 12, 12] }\n"
              "  - %s\n",
+             small_renders ? "[16, 16], spp: 4" : "[32, 32], spp: 16",
              camera ? camera : "{ from: [0.3, 0.8, 2.2], at: [0, 0.5, 0], fov: 40 }", materials ? materials : "",
              extra ? extra : "", shape);
     const char *scene = write_tmp("asset_scene.yaml", text), *path = tmp_path(out);
@@ -406,6 +430,16 @@ static void test_bad_input(void **state)
     text[strlen(text) / 2] = 0;
     snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }", write_tmp("cut.gltf", text));
     expect_error(shape, NULL, "Assimp cannot read it");
+    /* a PLY header without end_header, on which Assimp 5.2 reads forever (found by fuzz_asset) */
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }",
+             write_tmp("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nengd_header\n0\n1\n2\n"));
+    expect_error(shape, NULL, "its PLY header has no 'end_header' line");
+    /* a face of no vertices, on which Assimp 5.2's Triangulate step aborts (found by fuzz_asset) */
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: white }",
+             write_tmp("emptyface.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                       "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n"));
+    expect_error(shape, NULL, "mesh 0 face 1 has no vertices");
     expect_error("{ type: asset, file: model.stl, material: white }", NULL, "not a file murk reads as an asset");
     snprintf(shape, sizeof shape, "{ type: asset, file: %s/, material: white }", tmp_dir());
     expect_error(shape, NULL, "not a file murk reads as an asset");
@@ -419,6 +453,309 @@ static void test_bad_input(void **state)
     expect_error(shape, "{ from_asset: 1 }", "the file has no camera");
     expect_error(shape, "{ from_asset: 1, asset_camera: main }", "no camera 'main'");
     expect_error(shape, "{ from_asset: 1, from: [0, 0, 1] }", "'from' and from_asset exclude each other");
+}
+
+/* ---- textures, emission, lights in murk info ------------------------------------------------------------ */
+
+/* A w x h texture of four quadrants (top-left red, top-right green, bottom-left blue, bottom-right white; row 0
+ * at the top; flip: upside down), or of one colour c everywhere, written as an 8-bit PNG by murk's writer. */
+static const char *write_png(const char *name, int w, int h, const float *c, int flip)
+{
+    static const float q[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+    float *rgb = malloc(3u * (size_t)w * (size_t)h * sizeof(float));
+    assert_non_null(rgb);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int k = 0; k < 3; k++)
+                rgb[3 * (y * w + x) + k] = c ? c[k] : q[((y >= h / 2) != flip) * 2 + (x >= w / 2)][k];
+    static char p[4][512];
+    static int next;
+    char *path = p[next++ & 3], err[512];
+    snprintf(path, sizeof p[0], "%s", tmp_path(name));
+    if (murk_png_write(path, rgb, w, h, 0.0f, err, sizeof err))
+        fail_msg("%s", err);
+    free(rgb);
+    return path;
+}
+
+/* The quad center [0, 0.25, 0] +- [0.5, 0, 0] +- [0, 0, -0.5] as murk's `type: quad` makes it (load.c's put_quad:
+ * its vertices, triangles and uv), as a glTF buffer: 4 float3 positions, 4 float2 texture coordinates in glTF's
+ * convention (t = 1 - v: t = 0 is the image's top row), 6 uint16 indices; 92 bytes. */
+static size_t quad_buffer(unsigned char *b)
+{
+    const float p[12] = {-0.5f, 0.25f, 0.5f, 0.5f, 0.25f, 0.5f, 0.5f, 0.25f, -0.5f, -0.5f, 0.25f, -0.5f};
+    const float st[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    const uint16_t ix[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(b, p, 48);
+    memcpy(b + 48, st, 32);
+    memcpy(b + 80, ix, 12);
+    return 92;
+}
+
+#define QUAD_YAML "type: quad, center: [0, 0.25, 0], u: [0.5, 0, 0], v: [0, 0, -0.5]"
+
+/* The quad as a glTF with material 0 `material` and the top-level members `extra` (images, textures): a .gltf
+ * with its buffer embedded as base64, or (png: the bytes of image 0) a .glb whose BIN chunk holds the buffer and
+ * then the PNG, image 0 a view of it. */
+static const char *write_quad(const char *name, const char *material, const char *extra, const char *png)
+{
+    unsigned char bin[200000];
+    char json[8192], uri[300] = "";
+    size_t nb = quad_buffer(bin), npng = 0;
+    int glb = png != NULL;
+    if (glb) {
+        FILE *f = fopen(png, "rb");
+        assert_non_null(f);
+        npng = fread(bin + 92, 1, sizeof bin - 100, f);
+        fclose(f);
+        nb = 92 + npng;
+        while (nb % 4)
+            bin[nb++] = 0;
+    } else {
+        strcpy(uri, ", \"uri\": \"data:application/octet-stream;base64,");
+        base64(bin, nb, uri + strlen(uri));
+        strcat(uri, "\"");
+    }
+    snprintf(json, sizeof json,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],\n"
+             "\"nodes\": [{\"name\": \"quad\", \"mesh\": 0}],\n"
+             "\"meshes\": [{\"name\": \"quad\", \"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, "
+             "\"indices\": 2, \"material\": 0}]}],\n\"materials\": [%s],\n%s%s"
+             "\"buffers\": [{\"byteLength\": %zu%s}],\n"
+             "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, "
+             "\"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}%s],\n"
+             "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", "
+             "\"min\": [-0.5, 0.25, -0.5], \"max\": [0.5, 0.25, 0.5]},\n"
+             "  {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"},\n"
+             "  {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
+             material, extra ? extra : "", extra ? ",\n" : "", nb, uri,
+             glb ? ", {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": NPNG}" : "");
+    if (!glb)
+        return write_tmp(name, json);
+    char *at = strstr(json, "NPNG"), tail[8192];
+    snprintf(tail, sizeof tail, "%s", at + 4);
+    snprintf(at, sizeof json - (size_t)(at - json), "%zu%s", npng, tail);
+    return write_glb_chunks(name, json, bin, nb);
+}
+
+/* glTF's textures against the YAML quad with the same texture: the base colour texture (external PNG, and
+ * embedded in a .glb), the metallicRoughness texture's mix, the emissive strength. */
+static void test_textures(void **state)
+{
+    (void)state;
+    need_assimp();
+    nfail = 0;
+    small_renders = 1;
+    char shape[1200], mats[1200], png[512];
+    snprintf(png, sizeof png, "%s", write_png("quadrants.png", 16, 16, NULL, 0));
+    /* 1. base colour texture, metallic 0: the YAML quad with the same image as its ggx albedo */
+    const char *mat = "{\"name\": \"painted\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, "
+                      "\"metallicFactor\": 0, \"roughnessFactor\": 0.5}}";
+    char extra[600];
+    snprintf(extra, sizeof extra, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"quadrants.png\"}]");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }", write_quad("tex.gltf", mat, extra, NULL));
+    const char *a = render_scene(shape, NULL, NULL, NULL, "tex_gltf.exr");
+    static char keep_a[512];
+    snprintf(keep_a, sizeof keep_a, "%s", a);
+    snprintf(extra, sizeof extra, "\"textures\": [{\"source\": 0}], \"images\": [{\"bufferView\": 3, \"mimeType\": "
+             "\"image/png\"}]");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }", write_quad("tex.glb", mat, extra, png));
+    const char *g = render_scene(shape, NULL, NULL, NULL, "tex_glb.exr");
+    static char keep_g[512];
+    snprintf(keep_g, sizeof keep_g, "%s", g);
+    for (int k = 0; k < 2; k++) {
+        snprintf(mats, sizeof mats, "  painted: { type: ggx, albedo: { texture: image, file: %s }, specular: 0.04, "
+                 "roughness: 0.5 }\n", k ? write_png("flipped.png", 16, 16, NULL, 1) : png);
+        snprintf(shape, sizeof shape, "{ " QUAD_YAML ", material: painted }");
+        const char *b = render_scene(shape, mats, NULL, NULL, k ? "tex_flipped.exr" : "tex_yaml.exr");
+        expect(same_pixels(keep_a, b), !k, k ? "the texture upside down in v (must DIFFER)"
+                                            : "glTF base colour texture (.gltf, external PNG) = YAML quad");
+        if (!k)
+            expect(same_pixels(keep_g, b), 1, "glTF base colour texture (.glb, embedded PNG) = YAML quad");
+    }
+    /* 2. a uniform metallicRoughness texture (R 0, G 0 roughness, B 1 metallic: texels of 0 and 1, which the
+     * bilinear lookup returns exactly) times the factors: the documented ggx, computed in float as the mix does;
+     * the mix left out, and G and B swapped, must differ */
+    const float mrc[3] = {0.0f, 0.0f, 1.0f}, bf[3] = {0.8f, 0.3f, 0.2f}, mf = 0.5f, rf = 0.75f;
+    write_png("mr.png", 4, 4, mrc, 0);
+    char mat2[600];
+    snprintf(mat2, sizeof mat2, "{\"name\": \"metal\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [%.9g, %.9g, %.9g, 1], "
+             "\"metallicFactor\": %.9g, \"roughnessFactor\": %.9g, \"metallicRoughnessTexture\": {\"index\": 0}}}",
+             (double)bf[0], (double)bf[1], (double)bf[2], (double)mf, (double)rf);
+    snprintf(extra, sizeof extra, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"mr.png\"}]");
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }", write_quad("mr.gltf", mat2, extra, NULL));
+    a = render_scene(shape, NULL, NULL, NULL, "mr_gltf.exr");
+    snprintf(keep_a, sizeof keep_a, "%s", a);
+    static const char *const mr_what[3] = {"metallicRoughness texture x factors = the mapped ggx",
+                                           "the metallic mix left out (must DIFFER)", "G and B swapped (must DIFFER)"};
+    for (int k = 0; k < 3; k++) {
+        float m = (k == 2 ? mrc[1] : mrc[2]) * mf, r = (k == 2 ? mrc[2] : mrc[1]) * rf, al[3], sp[3];
+        for (int c = 0; c < 3; c++)
+            al[c] = k == 1 ? bf[c] : bf[c] * (1.0f - m), sp[c] = 0.04f * (1.0f - m) + bf[c] * m;
+        snprintf(mats, sizeof mats, "  metal: { type: ggx, albedo: [%.9g, %.9g, %.9g], specular: [%.9g, %.9g, %.9g], "
+                 "roughness: %.9g }\n", (double)al[0], (double)al[1], (double)al[2], (double)sp[0], (double)sp[1],
+                 (double)sp[2], (double)r);
+        snprintf(shape, sizeof shape, "{ " QUAD_YAML ", material: metal }");
+        expect(same_pixels(keep_a, render_scene(shape, mats, NULL, NULL, "mr_yaml.exr")), !k, mr_what[k]);
+    }
+    /* 3. KHR_materials_emissive_strength, which murk reads from the JSON (Assimp 5.2 drops it), against the
+     * quad as an OBJ mesh (a YAML quad's light is sampled as a rectangle, a mesh's by triangles) */
+    char quad_obj[512];
+    snprintf(quad_obj, sizeof quad_obj, "%s", write_tmp("quad.obj", "v -0.5 0.25 0.5\nv 0.5 0.25 0.5\nv 0.5 0.25 -0.5\n"
+                                                        "v -0.5 0.25 -0.5\nf 1 2 3\nf 1 3 4\n"));
+    const char *em = "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], "
+                     "\"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 0.5, 0.25], \"extensions\": "
+                     "{\"KHR_materials_emissive_strength\": {\"emissiveStrength\": 4}}}";
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }",
+             write_quad("strength.gltf", em, "\"extensionsUsed\": [\"KHR_materials_emissive_strength\"]", NULL));
+    a = render_scene(shape, NULL, NULL, NULL, "strength_gltf.exr");
+    snprintf(keep_a, sizeof keep_a, "%s", a);
+    for (int k = 0; k < 2; k++) {
+        snprintf(mats, sizeof mats, "  lamp: { type: ggx, albedo: [0.8, 0.8, 0.8], specular: 0.04, roughness: 1 }\n");
+        snprintf(shape, sizeof shape, "{ type: mesh, file: %s, material: lamp, emission: %s }", quad_obj,
+                 k ? "[1, 0.5, 0.25]" : "[4, 2, 1]");
+        expect(same_pixels(keep_a, render_scene(shape, mats, NULL, NULL, "strength_yaml.exr")), !k,
+               k ? "the strength left out (must DIFFER)" : "emissiveStrength 4 = the YAML quad's emission x 4");
+    }
+    small_renders = 0;
+    assert_int_equal(nfail, 0);
+}
+
+/* glTF's UV origin: the emissive texture's top-left quadrant (red) lies at texture coordinate (0, 0), which
+ * the file puts at the quad's corner nearest the camera's top-left; seen straight down, each quadrant of the
+ * image shows its colour (an upside-down reading shows blue and white on top). */
+static void test_uv_origin(void **state)
+{
+    (void)state;
+    need_assimp();
+    write_png("quadrants.png", 16, 16, NULL, 0);
+    const char *em = "{\"name\": \"screen\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, "
+                     "\"emissiveFactor\": [1, 1, 1], \"emissiveTexture\": {\"index\": 0}}";
+    const char *g = write_quad("uv.gltf", em, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"quadrants.png\"}]",
+                               NULL);
+    char text[2048];
+    /* looking down -y with up = -z: image right is +x, image top is -z; the quad's texcoord (0, 0) vertex is
+     * (-0.5, 0.25, -0.5), the top-left */
+    snprintf(text, sizeof text, "murk: 1\nrender: { resolution: [16, 16], spp: 4, seed: 1 }\n"
+             "camera: { from: [0, 3, 0], at: [0, 0, 0], up: [0, 0, -1], fov: 20 }\n"
+             "shapes:\n  - { type: asset, file: %s, material: from_file }\n", g);
+    const char *scene = write_tmp("uv.yaml", text), *out = tmp_path("uv.exr");
+    const char *args[] = {"render", scene, "-o", out, "--quiet", NULL};
+    run_murk_ok(args, NULL);
+    murk_image img = {0};
+    char err[512];
+    assert_int_equal(murk_exr_read(out, &img, err, sizeof err), 0);
+    static const float want[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+    static const char *const names[4] = {"top-left red", "top-right green", "bottom-left blue", "bottom-right white"};
+    for (int q = 0; q < 4; q++) {
+        int x = (q & 1) ? 10 : 5, y = (q & 2) ? 10 : 5; /* well inside each quadrant of the quad's image */
+        const float *px = &img.rgb[3 * (y * img.w + x)];
+        printf("  pixel (%d, %d): [%.3f, %.3f, %.3f], want %s\n", x, y, (double)px[0], (double)px[1], (double)px[2], names[q]);
+        for (int c = 0; c < 3; c++)
+            assert_true(fabsf(px[c] - want[q][c]) < 0.02f);
+    }
+    murk_image_free(&img);
+}
+
+/* An emissive texture lights the room as the part of the mesh it lights: the glTF quad (facing down) whose
+ * emissive texture is white in its top half and black below, against the YAML scene with that half as an
+ * emissive OBJ mesh and the other half as a plain one. Light samples land on the texture (render/lights.c's
+ * textured_le) and BSDF-sampled hits see it (host.c): independent seeds, block-wise z (stat.h); must-fail:
+ * the other half emitting. 1024 texture rows, so the bilinear blur at the two edges of the white half
+ * (half a row each) moves the lamp's power by 0.1 %, below the comparison's resolution. */
+#define EM_SEEDS 4
+static void test_emission_texture(void **state)
+{
+    (void)state;
+    need_assimp();
+    float *rgb = malloc(3 * 1024 * sizeof(float));
+    assert_non_null(rgb);
+    for (int y = 0; y < 1024; y++)
+        for (int k = 0; k < 3; k++)
+            rgb[3 * y + k] = y < 512 ? 1.0f : 0.0f;
+    char err[512];
+    if (murk_png_write(tmp_path("halves.png"), rgb, 1, 1024, 0.0f, err, sizeof err))
+        fail_msg("%s", err);
+    free(rgb);
+    const char *em = "{\"name\": \"panel\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1], "
+                     "\"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1], "
+                     "\"emissiveTexture\": {\"index\": 0}}";
+    char g[512], lit[2][512], text[3][4096];
+    snprintf(g, sizeof g, "%s", write_quad("halves.gltf", em, "\"textures\": [{\"source\": 0}], \"images\": "
+                                           "[{\"uri\": \"halves.png\"}]", NULL));
+    /* murk's v = 1 (glTF t = 0, the white rows) is the quad's z = -0.5 edge: the white half is z in [-0.5, 0] */
+    snprintf(lit[0], sizeof lit[0], "%s", write_tmp("half_white.obj", "v -0.5 0.25 0\nv 0.5 0.25 0\nv 0.5 0.25 -0.5\n"
+                                                    "v -0.5 0.25 -0.5\nf 1 2 3\nf 1 3 4\n"));
+    snprintf(lit[1], sizeof lit[1], "%s", write_tmp("half_black.obj", "v -0.5 0.25 0.5\nv 0.5 0.25 0.5\nv 0.5 0.25 0\n"
+                                                    "v -0.5 0.25 0\nf 1 2 3\nf 1 3 4\n"));
+    const char *head = "murk: 1\nrender: { resolution: [24, 24], spp: 16 }\n"
+                       "camera: { from: [0, 0.2, 2.4], at: [0, -0.9, 0], fov: 55 }\n"
+                       "materials:\n  white: { type: diffuse, albedo: 0.8 }\n%s"
+                       "shapes:\n  - { type: quad, center: [0, -1, 0], u: [1.5, 0, 0], v: [0, 0, -1.5], material: white }\n";
+    const char *flip = "transform: { rotate: [180, 0, 0] }"; /* the quad faces down, at y = -0.25 */
+    const char *panel = "  panel: { type: ggx, albedo: [0.5, 0.5, 0.5], specular: 0.04, roughness: 1 }\n";
+    char h0[1024], h1[1024];
+    snprintf(h0, sizeof h0, head, "");
+    snprintf(h1, sizeof h1, head, panel);
+    snprintf(text[0], sizeof text[0], "%s  - { type: asset, file: %s, material: from_file, %s }\n", h0, g, flip);
+    for (int k = 0; k < 2; k++)
+        snprintf(text[1 + k], sizeof text[1], "%s  - { type: mesh, file: %s, material: panel, emission: 1, %s }\n"
+                 "  - { type: mesh, file: %s, material: panel, %s }\n", h1, lit[k], flip, lit[!k], flip);
+    img_stack a, r, wrong;
+    img_stack_render(&a, write_tmp("em_gltf.yaml", text[0]), "em_gltf.exr", EM_SEEDS, 10, NULL);
+    img_stack_render(&r, write_tmp("em_yaml.yaml", text[1]), "em_yaml.exr", EM_SEEDS, 1000, NULL);
+    img_stack_render(&wrong, write_tmp("em_wrong.yaml", text[2]), "em_wrong.exr", EM_SEEDS, 2000, NULL);
+    int ok = img_stack_agree("emissive texture = its white half as an emissive mesh", &a, &r, 4);
+    ok &= img_stack_must_differ("the other half emitting (must DIFFER)", &wrong, &r, 4);
+    img_stack_free(&a);
+    img_stack_free(&r);
+    img_stack_free(&wrong);
+    assert_true(ok);
+}
+
+/* murk info lists the lights: the lights: block's and the glTF's KHR_lights_punctual ones, with where each
+ * came from. */
+static void test_info_lights(void **state)
+{
+    (void)state;
+    need_assimp();
+    const char *extra = "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": "
+                        "{\"lights\": [{\"name\": \"bulb\", \"type\": \"point\", \"color\": [1, 0.5, 0.25], \"intensity\": 2}]}}";
+    const char *nodes = ", {\"name\": \"bulb\", \"translation\": [0.5, 1.25, 0.75], \"extensions\": "
+                        "{\"KHR_lights_punctual\": {\"light\": 0}}}";
+    const char *g = write_gltf("info_lights.gltf", NULL, nodes, extra, 2, 0);
+    char text[2048];
+    snprintf(text, sizeof text, "murk: 1\nrender: { resolution: [8, 8], spp: 1 }\n"
+             "materials:\n  white: { type: diffuse }\n"
+             "shapes:\n  - { type: asset, file: %s, material: white }\n"
+             "lights:\n  - { type: spot, position: [0, 2, 0], direction: [0, -1, 0], intensity: 3, cone_angle: 40 }\n", g);
+    const char *scene = write_tmp("info_lights.yaml", text);
+    char *log = NULL;
+    const char *args[] = {"info", scene, NULL};
+    assert_int_equal(run_murk_argv(&log, args), 0);
+    char want[3][700];
+    snprintf(want[0], sizeof want[0], "lights (2)");
+    snprintf(want[1], sizeof want[1], "spot    position [0, 2, 0], direction [0, -1, 0], intensity [3, 3, 3] W/sr, "
+             "cone_angle 40, falloff_angle 35, from %s:8:5 lights[0]", scene);
+    snprintf(want[2], sizeof want[2], "point   position [0.5, 1.25, 0.75], intensity [2, 1, 0.5] W/sr, from %s light "
+             "'bulb' (%s:6:", g, scene);
+    for (int i = 0; i < 3; i++)
+        if (!strstr(log, want[i]))
+            fail_msg("murk info lacks \"%s\":\n%s", want[i], log);
+    free(log);
+}
+
+/* A glTF whose base colour texture is missing: a located error naming it, no image. */
+static void test_bad_texture(void **state)
+{
+    (void)state;
+    need_assimp();
+    const char *mat = "{\"name\": \"lost\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}";
+    const char *g = write_quad("lost.gltf", mat, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"nothere.png\"}]",
+                               NULL);
+    char shape[700];
+    snprintf(shape, sizeof shape, "{ type: asset, file: %s, material: from_file }", g);
+    expect_error(shape, NULL, "material 0 'lost': base colour texture 'nothere.png'");
 }
 
 static void test_scene(void **state)
@@ -462,7 +799,7 @@ static void test_scene(void **state)
     murk_image_free(&img);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_formats),
@@ -471,8 +808,13 @@ int main(void)
         cmocka_unit_test(test_lights),
         cmocka_unit_test(test_scene),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_textures),
+        cmocka_unit_test(test_uv_origin),
+        cmocka_unit_test(test_emission_texture),
+        cmocka_unit_test(test_info_lights),
+        cmocka_unit_test(test_bad_texture),
     };
     if (getenv("MURK_TEST_FILTER"))
         cmocka_set_test_filter(getenv("MURK_TEST_FILTER"));
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return STAT_RUN(tests, argc, argv);
 }

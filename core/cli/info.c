@@ -1,13 +1,14 @@
 /* info.c — `murk info SCENE.yaml [--set KEY.PATH=VALUE ...]`: loads a scene as `murk render` does (same
  * checks, same messages) and lists what it holds: render settings, camera, integrator, media (tracker,
- * transmittance estimator, density, majorant grid), materials, shapes (material, interior, exterior) and
- * every plugin loaded, with its file. Renders nothing. Given an image instead (IMAGE.png, IMAGE.exr): its
+ * transmittance estimator, density, majorant grid), materials, shapes (material, interior, exterior), the
+ * lights (the `lights:` block's and assets', each with where it came from) and every plugin loaded, with its file. Renders nothing. Given an image instead (IMAGE.png, IMAGE.exr): its
  * size and text keys, murk:commit among them. Part of the murk executable, not of libmurk. */
 #include "cli/cli.h"
 #include "image/image.h"
 #include "load/load.h"
 #include "media/density.h"
 #include "media/media.h"
+#include "render/envmap.h"
 #include "scene/scene.h"
 #include "util/util.h"
 
@@ -122,6 +123,50 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
 
 static const char *medium_name(const murk_medium *m) { return m ? m->name : "vacuum"; }
 
+/* The lights of the `lights:` block and of assets (KHR_lights_punctual), each with where it came from
+ * (emissive shapes are listed with the shapes). */
+static void info_lights(const murk_scene *s)
+{
+    char buf[600];
+    printf("lights (%zu)\n", s->nadded);
+    for (size_t i = 0; i < s->nadded; i++) {
+        const murk_light *l = &s->added[i];
+        const char *where = "added from C";
+        for (size_t k = 0; k < s->nlight_origins; k++)
+            if (i >= s->light_origins[k].first && i < s->light_origins[k].first + s->light_origins[k].n)
+                where = s->light_origins[k].where;
+        switch (l->kind) {
+        case MURK_LK_POINT:
+            printf("  %-3zu point  ", i);
+            put_vec(" position", l->center);
+            put_rgb(", intensity", l->le);
+            printf(" W/sr");
+            break;
+        case MURK_LK_SPOT:
+            printf("  %-3zu spot   ", i);
+            put_vec(" position", l->center);
+            put_vec(", direction", l->n);
+            put_rgb(", intensity", l->le);
+            printf(" W/sr, cone_angle %g, falloff_angle %g", acos(fmin(1.0, fmax(-1.0, l->cos_cone))) * 180.0 / M_PI,
+                   acos(fmin(1.0, fmax(-1.0, l->cos_falloff))) * 180.0 / M_PI);
+            break;
+        case MURK_LK_DISTANT:
+            printf("  %-3zu distant", i);
+            put_vec(" direction", l->n);
+            put_rgb(", irradiance", l->le);
+            printf(" W/m^2, angular_diameter %g", l->omc > 0.0f ? 2.0 * acos(1.0 - l->omc) * 180.0 / M_PI : 0.0);
+            break;
+        default:
+            printf("  %-3zu envmap ", i);
+            if (l->env)
+                printf(" %dx%d texels (scale applied)", l->env->w, l->env->h);
+            else
+                put_rgb(" constant radiance", l->le);
+        }
+        printf(", from %s\n", murk_printable(buf, sizeof buf, where));
+    }
+}
+
 static void info_scene(const murk_scene *s, const char *path, const char *const *sets, size_t nsets)
 {
     char buf[1024];
@@ -169,6 +214,7 @@ static void info_scene(const murk_scene *s, const char *path, const char *const 
             printf(", file %s (%u triangles)", murk_printable(buf, sizeof buf, sh->name), sh->ntris);
         putchar('\n');
     }
+    info_lights(s);
     printf("plugins (%zu)\n", s->reg.nloaded);
     for (size_t i = 0; i < s->reg.nloaded; i++) {
         const murk_plugin *p = s->reg.loaded[i];

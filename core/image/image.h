@@ -25,6 +25,9 @@ int murk_exr_read(const char *path, murk_image *img, char *err, size_t errlen);
 int murk_png_write(const char *path, const float *rgb, int w, int h, float exposure, char *err, size_t errlen);
 /* Decodes 8/16-bit grey/RGB/RGBA/palette PNGs; sRGB-encoded values are converted to linear when srgb=1. */
 int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen);
+/* The same from size bytes in memory (a glTF binary's embedded image), named name in messages. */
+int murk_png_read_memory(const void *data, size_t size, const char *name, int srgb, murk_image *img, char *err,
+                         size_t errlen);
 const char *murk_image_meta(const murk_image *img, const char *key); /* NULL if absent */
 /* 1 if w x h is positive and 3*w*h floats (and 12*w bytes per row) can be addressed. */
 int murk_image_size_ok(long long w, long long h);

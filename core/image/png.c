@@ -10,10 +10,12 @@
 #include "image/image.h"
 #include "util/atomic.h"
 #include "util/error.h"
+#include "util/limit.h"
 #include "util/util.h"
 
 #include <math.h>
 #include <setjmp.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -202,21 +204,16 @@ static int png_decode(png_job *j)
     return png_copy_text(j);
 }
 
-MURK_API int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
+/* The read of a PNG open as fp (size bytes; closed here), named path in messages. */
+static int png_read_fp(FILE *fp, uint64_t size, const char *path, int srgb, murk_image *img, char *err, size_t errlen)
 {
     png_job j;
     memset(&j, 0, sizeof j);
-    int rc = 0, fd = murk_image_open_input(path, img, err, errlen);
-    if (fd < 0)
-        return -1;
+    int rc = 0;
     j.path = path;
     j.img = img;
-    j.file_size = murk_image_fd_size(fd);
-    j.fp = fdopen(fd, "rb");
-    if (!j.fp) {
-        close(fd);
-        return murk_err_file(err, errlen, path, "out of memory");
-    }
+    j.file_size = size;
+    j.fp = fp;
     unsigned char sig[8];
     if (fread(sig, 1, sizeof sig, j.fp) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         fclose(j.fp);
@@ -256,4 +253,31 @@ MURK_API int murk_png_read(const char *path, int srgb, murk_image *img, char *er
     if (rc != 0)
         murk_image_free(img); /* the text keys read before the failure */
     return rc;
+}
+
+MURK_API int murk_png_read(const char *path, int srgb, murk_image *img, char *err, size_t errlen)
+{
+    int fd = murk_image_open_input(path, img, err, errlen);
+    if (fd < 0)
+        return -1;
+    uint64_t size = murk_image_fd_size(fd);
+    FILE *fp = fdopen(fd, "rb");
+    if (!fp) {
+        close(fd);
+        return murk_err_file(err, errlen, path, "out of memory");
+    }
+    return png_read_fp(fp, size, path, srgb, img, err, errlen);
+}
+
+int murk_png_read_memory(const void *data, size_t size, const char *name, int srgb, murk_image *img, char *err,
+                         size_t errlen)
+{
+    memset(img, 0, sizeof *img);
+    if (size > murk_limit(MURK_LIMIT_FILE_BYTES))
+        return murk_err_file(err, errlen, name, "more than %llu bytes, the limit (%s)",
+                             (unsigned long long)murk_limit(MURK_LIMIT_FILE_BYTES), murk_limit_name(MURK_LIMIT_FILE_BYTES));
+    FILE *fp = size ? fmemopen((void *)(uintptr_t)data, size, "rb") : NULL;
+    if (!fp)
+        return murk_err_file(err, errlen, name, size ? "out of memory" : "not a PNG file (no bytes)");
+    return png_read_fp(fp, size, name, srgb, img, err, errlen);
 }

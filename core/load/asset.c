@@ -9,7 +9,8 @@
  * one made from its material in the file (below); without a material the meshes are index-matched medium
  * boundaries (interior required), as a mesh shape's. `emission` makes every mesh emissive; with from_file
  * and no emission, a material's emissive factor does (times its emissive intensity where Assimp reads one:
- * Debian's Assimp 5.2.5 does not read glTF's KHR_materials_emissive_strength, so a glTF emitter is at most 1).
+ * Debian's Assimp 5.2.5 drops glTF's KHR_materials_emissive_strength: murk reads it from the JSON itself,
+ * emissive_strengths below, and matches it to Assimp's materials by name).
  *
  * Materials (from_file): murk's ggx (plugins/materials/ggx.c), from glTF's metallic-roughness model the
  * way the glTF specification mixes its dielectric and metal BRDFs (Appendix B, "fresnel_mix"):
@@ -18,7 +19,10 @@
  * A file without metallic-roughness (OBJ's .mtl, FBX's Phong, PLY's default) maps its diffuse colour to
  * albedo, its specular colour (averaged, clamped to [0, 1]) to specular and its Phong exponent n to
  * roughness = (2 / (n + 2))^(1/4) (Walter et al. 2007's alpha = sqrt(2 / (n + 2)) for Blinn-Phong).
- * Textures in the file are not read: the factor alone is used, and murk says so once per file.
+ * Textures (file_texture): glTF's base colour (sRGB), metallicRoughness (linear; G roughness, B metallic) and
+ * emissive textures, other formats' diffuse map, read as murk's image textures (PNG beside the file, or
+ * embedded in a .glb) and mixed per hit by the formulas above (scene/texture.c's murk_texture_gltf); an
+ * emissive texture is the mesh's emission_tex (render/host.c, render/lights.c). README, Assets.
  *
  * Lights (lights: true): KHR_lights_punctual's point, spot and directional lights become murk's point, spot
  * and distant lights (render/lights.h), placed by their nodes; intensity = colour x intensity x
@@ -38,7 +42,9 @@
  * bitwise images come from. type: asset reads .obj through Assimp too, for OBJ files with materials. */
 #include "load/load.h"
 #include "render/lights.h"
+#include "image/image.h"
 #include "scene/params.h"
+#include "scene/texture.h"
 #include "util/error.h"
 #include "util/file.h"
 #include "util/limit.h"
@@ -125,9 +131,15 @@ typedef struct asset_ctx {
     const murk_material **made;  /* from_file: the murk material of each of the file's materials */
     murk_rgb *made_emission;
     size_t *cap;                 /* capacity of s->shapes */
+    const struct murk_texture **made_emission_tex;
     uint64_t triangles;
     int depth;
-    int textures_noted;
+    char *path;                  /* the file's path (textures are found relative to it) */
+    struct gltf_strength { char name[160]; double strength; } *strength; /* glTF: KHR_materials_emissive_strength */
+    size_t nstrength;
+    struct tex_cache { char key[MAXLEN]; int srgb; const struct murk_texture *t; } *cache; /* images read */
+    size_t ncache;
+    int noted_format, noted_unread, noted_mix, noted_uv, noted_strength;
 } asset_ctx;
 
 /* ---- materials ---------------------------------------------------------------------------------- */
@@ -153,21 +165,24 @@ static int get_float(const struct aiMaterial *m, const char *key, unsigned type,
 
 static float clamp01(float v) { return v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v); }
 
-/* The ggx parameters of a file material (the mapping at the top of this file). */
-static void ggx_of(const struct aiMaterial *m, float albedo[3], float specular[3], float *roughness)
+/* The ggx parameters of a file material (the mapping at the top of this file); 1 if it is a
+ * metallic-roughness one, with its base colour and metallic factors in base and *metallic. */
+static int ggx_of(const struct aiMaterial *m, float albedo[3], float specular[3], float *roughness, float base[3],
+                  float *metallic_out)
 {
-    float base[3] = {0.8f, 0.8f, 0.8f}, metallic = 0.0f, ks[3];
+    float metallic = 0.0f, ks[3];
+    base[0] = base[1] = base[2] = 0.8f;
     int pbr = get_float(m, AI_MATKEY_METALLIC_FACTOR, &metallic) | get_float(m, AI_MATKEY_ROUGHNESS_FACTOR, roughness);
     if (!get_colour(m, AI_MATKEY_BASE_COLOR, base))
         get_colour(m, AI_MATKEY_COLOR_DIFFUSE, base);
+    *metallic_out = metallic = clamp01(metallic);
     if (pbr) {
-        metallic = clamp01(metallic);
         for (int c = 0; c < 3; c++) {
             albedo[c] = clamp01(base[c] * (1.0f - metallic));
             specular[c] = clamp01(0.04f * (1.0f - metallic) + base[c] * metallic);
         }
         *roughness = clamp01(*roughness);
-        return;
+        return 1;
     }
     float ns = 0.0f, k = 0.04f;
     if (get_colour(m, AI_MATKEY_COLOR_SPECULAR, ks))
@@ -178,45 +193,354 @@ static void ggx_of(const struct aiMaterial *m, float albedo[3], float specular[3
         specular[c] = k;
     }
     *roughness = clamp01(powf(2.0f / (fmaxf(ns, 0.0f) + 2.0f), 0.25f));
+    return 0;
 }
 
-/* murk's ggx for the file's material i, made once (from_file). */
-static const murk_material *file_material(asset_ctx *a, unsigned i, murk_rgb *emission, char *err, size_t errlen)
+/* ---- textures of the file's materials (material: from_file) ------------------------------------------ */
+
+/* Where a warning about the asset points: "scene.yaml:L:C: FILE". */
+#define AT(a) (a)->file->file, (a)->file->line, (a)->file->col, (a)->name
+
+/* w x h texels of 8-bit RGB (stride bytes apart, in the channel order r, g, b at offsets ro, go, bo) as
+ * linear floats (the sRGB EOTF if srgb), into img. 0, or -1 if the size is not one murk takes. */
+static int texels_8bit(const unsigned char *px, unsigned w, unsigned h, size_t stride, int ro, int go, int bo, int srgb,
+                       murk_image *img)
+{
+    memset(img, 0, sizeof *img);
+    if (!murk_image_size_ok(w, h) || (uint64_t)w * h > murk_limit(MURK_LIMIT_IMAGE_PIXELS))
+        return -1;
+    float lut[256];
+    for (int v = 0; v < 256; v++)
+        lut[v] = (float)(srgb ? (v / 255.0 <= 0.04045 ? v / 255.0 / 12.92 : pow((v / 255.0 + 0.055) / 1.055, 2.4)) : v / 255.0);
+    img->w = (int)w, img->h = (int)h;
+    img->rgb = murk_xmalloc(3u * (size_t)w * h * sizeof(float));
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        img->rgb[3 * i] = lut[px[i * stride + (size_t)ro]];
+        img->rgb[3 * i + 1] = lut[px[i * stride + (size_t)go]];
+        img->rgb[3 * i + 2] = lut[px[i * stride + (size_t)bo]];
+    }
+    return 0;
+}
+
+/* Texture `type` of the file's material m (`what` names it, e.g. "baseColorTexture"; mlabel the material) as
+ * an image texture the scene keeps, read once per file: an external file relative to the asset, or an image
+ * embedded in the file (Assimp's "*N": compressed bytes when its mHeight is 0, else BGRA texels). *out is NULL
+ * when m has none, or one murk cannot decode (not PNG: said once, the factor alone is used). 0, or -1 with a
+ * located err (a file that is missing or not a readable PNG). */
+static int file_texture(asset_ctx *a, const struct aiMaterial *m, enum aiTextureType type, const char *what,
+                        const char *mlabel, int srgb, const murk_texture **out, char *err, size_t errlen)
+{
+    *out = NULL;
+    struct aiString p;
+    unsigned uv = 0;
+    if (aiGetMaterialTextureCount(m, type) == 0 ||
+        aiGetMaterialTexture(m, type, 0, &p, NULL, &uv, NULL, NULL, NULL, NULL) != AI_SUCCESS || !p.data[0])
+        return 0;
+    char shown[256], ierr[768];
+    murk_printable(shown, sizeof shown, p.data);
+    if (uv != 0 && !a->noted_uv++)
+        murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: %s uses UV set %u; murk reads UV set 0 only", AT(a), mlabel,
+                 what, uv);
+    for (size_t i = 0; i < a->ncache; i++)
+        if (a->cache[i].srgb == srgb && !strcmp(a->cache[i].key, p.data)) {
+            *out = a->cache[i].t;
+            return 0;
+        }
+    murk_image img;
+    char name[300];
+    if (p.data[0] == '*') { /* embedded */
+        char *end;
+        long k = strtol(p.data + 1, &end, 10);
+        if (*end || end == p.data + 1 || k < 0 || (unsigned long)k >= a->ai->mNumTextures || !a->ai->mTextures[k])
+            return ERR(a->file, "%s: material %s: %s names embedded image '%s' of %u", a->name, mlabel, what, shown,
+                       a->ai->mNumTextures);
+        const struct aiTexture *tx = a->ai->mTextures[k];
+        snprintf(name, sizeof name, "%s#image%ld", a->name, k);
+        if (!tx->pcData)
+            return ERR(a->file, "%s: material %s: %s: embedded image %ld holds no data", a->name, mlabel, what, k);
+        if (tx->mHeight == 0) {
+            const unsigned char *bytes = (const unsigned char *)tx->pcData;
+            if (tx->mWidth < 8 || memcmp(bytes, "\x89PNG\r\n\x1a\n", 8)) {
+                char hint[16];
+                murk_printable(hint, sizeof hint, tx->achFormatHint);
+                if (!a->noted_format++)
+                    murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: %s is an embedded %s image; murk decodes PNG "
+                             "only, so its factor alone is used", AT(a), mlabel, what, hint[0] ? hint : "non-PNG");
+                return 0;
+            }
+            if (murk_png_read_memory(bytes, tx->mWidth, name, srgb, &img, ierr, sizeof ierr))
+                return ERR(a->file, "%s: material %s: %s: %s", a->name, mlabel, what, ierr);
+        } else if (texels_8bit((const unsigned char *)tx->pcData, tx->mWidth, tx->mHeight, sizeof(struct aiTexel), 2, 1,
+                               0, srgb, &img))
+            return ERR(a->file, "%s: material %s: %s: embedded image %ld is %ux%u texels, a size murk does not take",
+                       a->name, mlabel, what, k, tx->mWidth, tx->mHeight);
+    } else { /* a file beside the asset */
+        char *tp = murk_path_relative_to(a->path, p.data);
+        uint64_t size;
+        FILE *fp = murk_file_open_regular(tp, &size, ierr, sizeof ierr);
+        if (!fp) {
+            free(tp);
+            return ERR(a->file, "%s: material %s: %s '%s': %s", a->name, mlabel, what, shown, ierr);
+        }
+        fclose(fp);
+        if (!ends_with(p.data, ".png")) {
+            free(tp);
+            if (!a->noted_format++)
+                murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: %s '%s' is not a PNG file; murk decodes PNG only, "
+                         "so its factor alone is used", AT(a), mlabel, what, shown);
+            return 0;
+        }
+        int rc = murk_png_read(tp, srgb, &img, ierr, sizeof ierr);
+        if (rc) {
+            free(tp);
+            return ERR(a->file, "%s: material %s: %s '%s': %s", a->name, mlabel, what, shown, ierr);
+        }
+        murk_scene *s = a->s; /* the checkpoint's content hash covers it (load.c) */
+        s->asset_inputs = murk_xrealloc(s->asset_inputs, (s->nasset_inputs + 1) * sizeof *s->asset_inputs);
+        s->asset_inputs[s->nasset_inputs++] = tp;
+        snprintf(name, sizeof name, "%s", shown);
+    }
+    *out = murk_scene_keep_texture(a->s, murk_texture_from_image(&img, name));
+    a->cache = murk_xrealloc(a->cache, (a->ncache + 1) * sizeof *a->cache);
+    memcpy(a->cache[a->ncache].key, p.data, sizeof p.data);
+    a->cache[a->ncache].srgb = srgb;
+    a->cache[a->ncache++].t = *out;
+    return 0;
+}
+
+/* ---- KHR_materials_emissive_strength, from the glTF's JSON ------------------------------------------- */
+
+/* Debian's Assimp 5.2 drops this extension, so murk reads it itself: a scanner of just enough JSON to
+ * find materials[i].extensions.KHR_materials_emissive_strength.emissiveStrength (RFC 8259's grammar,
+ * nesting at most 64 deep; anything malformed ends the scan and leaves the strengths read so far). */
+typedef struct json { const char *p, *end; int depth; } json;
+
+static void j_ws(json *j)
+{
+    while (j->p < j->end && (*j->p == ' ' || *j->p == '\t' || *j->p == '\n' || *j->p == '\r'))
+        j->p++;
+}
+
+/* A string at p: its contents' bounds (escapes left as they are); 0 if there is none. */
+static int j_string(json *j, const char **s, size_t *n)
+{
+    j_ws(j);
+    if (j->p >= j->end || *j->p != '"')
+        return 0;
+    const char *b = ++j->p;
+    while (j->p < j->end && *j->p != '"')
+        j->p += *j->p == '\\' ? 2 : 1;
+    if (j->p >= j->end)
+        return 0;
+    *s = b, *n = (size_t)(j->p++ - b);
+    return 1;
+}
+
+static int j_skip(json *j)
+{
+    j_ws(j);
+    if (j->p >= j->end || ++j->depth > 64)
+        return 0;
+    int ok = 1;
+    const char *s;
+    size_t n;
+    if (*j->p == '"')
+        ok = j_string(j, &s, &n);
+    else if (*j->p == '{' || *j->p == '[') {
+        char close = *j->p == '{' ? '}' : ']';
+        int obj = *j->p++ == '{';
+        j_ws(j);
+        if (j->p < j->end && *j->p == close)
+            j->p++;
+        else
+            for (;;) {
+                if (obj && !(j_string(j, &s, &n) && (j_ws(j), j->p < j->end && *j->p++ == ':')))
+                    return 0;
+                if (!j_skip(j))
+                    return 0;
+                j_ws(j);
+                if (j->p >= j->end)
+                    return 0;
+                if (*j->p == close) {
+                    j->p++;
+                    break;
+                }
+                if (*j->p++ != ',')
+                    return 0;
+            }
+    } else { /* a number or a literal */
+        const char *b = j->p;
+        while (j->p < j->end && *j->p && strchr("+-.0123456789eEtruefalsn", *j->p))
+            j->p++;
+        ok = j->p > b;
+    }
+    j->depth--;
+    return ok;
+}
+
+/* In the object at p, the value of key: p left at it (1), or 0 (p past the object, or anywhere if malformed). */
+static int j_find(json *j, const char *key)
+{
+    j_ws(j);
+    if (j->p >= j->end || *j->p != '{')
+        return 0;
+    j->p++;
+    j_ws(j);
+    if (j->p < j->end && *j->p == '}')
+        return 0;
+    for (;;) {
+        const char *s;
+        size_t n;
+        if (!j_string(j, &s, &n) || (j_ws(j), j->p >= j->end || *j->p++ != ':'))
+            return 0;
+        if (n == strlen(key) && !memcmp(s, key, n))
+            return 1;
+        if (!j_skip(j))
+            return 0;
+        j_ws(j);
+        if (j->p >= j->end || *j->p++ != ',')
+            return 0;
+    }
+}
+
+/* Each material of the glTF or binary glTF data with KHR_materials_emissive_strength: its name (as the JSON
+ * writes it, escapes and all) and strength; n of them. */
+static struct gltf_strength *emissive_strengths(const unsigned char *data, size_t size, size_t *n)
+{
+    *n = 0;
+    json j = {(const char *)data, (const char *)data + size, 0};
+    if (size >= 20 && !memcmp(data, "glTF", 4)) { /* binary glTF: the JSON chunk comes first */
+        uint32_t len = (uint32_t)data[12] | (uint32_t)data[13] << 8 | (uint32_t)data[14] << 16 | (uint32_t)data[15] << 24;
+        if (memcmp(data + 16, "JSON", 4) || len > size - 20)
+            return NULL;
+        j.p = (const char *)data + 20, j.end = j.p + len;
+    }
+    if (!j_find(&j, "materials") || (j_ws(&j), j.p >= j.end || *j.p++ != '['))
+        return NULL;
+    struct gltf_strength *st = NULL;
+    for (;;) {
+        j_ws(&j);
+        if (j.p >= j.end || *j.p == ']')
+            break;
+        json m = j, e;
+        const char *name = "";
+        size_t nl = 0;
+        if (!j_find(&m, "name") || !j_string(&m, &name, &nl))
+            name = "", nl = 0;
+        m = j;
+        if (j_find(&m, "extensions") && (e = m, j_find(&e, "KHR_materials_emissive_strength"))) {
+            st = murk_xrealloc(st, (*n + 1) * sizeof *st);
+            struct gltf_strength *g = &st[(*n)++];
+            snprintf(g->name, sizeof g->name, "%.*s", (int)(nl < sizeof g->name ? nl : sizeof g->name - 1), name);
+            g->strength = -1.0; /* unreadable */
+            if (j_find(&e, "emissiveStrength")) {
+                char num[64];
+                size_t k = 0;
+                j_ws(&e);
+                while (e.p < e.end && k + 1 < sizeof num && *e.p && strchr("+-.0123456789eE", *e.p))
+                    num[k++] = *e.p++;
+                num[k] = 0;
+                char *stop;
+                double v = strtod(num, &stop);
+                g->strength = k && !*stop && isfinite(v) && v >= 0.0 ? v : -1.0;
+            } else {
+                g->strength = 1.0; /* the extension's default */
+            }
+        }
+        if (!j_skip(&j) || (j_ws(&j), j.p >= j.end) || *j.p == ']' || *j.p++ != ',')
+            break;
+    }
+    return st;
+}
+
+/* The emissive strength murk read for the file's material called name (1: none); a material carrying the
+ * extension that murk cannot tell apart (no name, or one that two materials share) or whose strength is not a
+ * number >= 0 is named in a warning, once per file, and gets 1. */
+static float strength_of(asset_ctx *a, const char *name, const char *mlabel)
+{
+    size_t hits = 0, at = 0;
+    for (size_t k = 0; k < a->nstrength; k++)
+        if (!strcmp(a->strength[k].name, name))
+            hits++, at = k;
+    if (!hits)
+        return 1.0f;
+    if (hits == 1 && name[0] && a->strength[at].strength >= 0.0)
+        return (float)fmin(a->strength[at].strength, 1e30);
+    if (!a->noted_strength++)
+        murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: its KHR_materials_emissive_strength is left out (%s)",
+                 AT(a), mlabel, a->strength[at].strength < 0.0 ? "its emissiveStrength is not a number >= 0"
+                 : "murk matches it to the file's material by name, and this name is empty or not unique");
+    return 1.0f;
+}
+
+/* murk's ggx for the file's material i, made once (from_file), with its emission and emission texture. */
+static const murk_material *file_material(asset_ctx *a, unsigned i, murk_rgb *emission, const murk_texture **etex,
+                                          char *err, size_t errlen)
 {
     if (a->made[i]) {
         *emission = a->made_emission[i];
+        *etex = a->made_emission_tex[i];
         return a->made[i];
     }
     const struct aiMaterial *m = a->ai->mMaterials[i];
     struct aiString nm;
-    char mname[160] = "";
+    char mname[160] = "", label[400];
     if (aiGetMaterialString(m, AI_MATKEY_NAME, &nm) == AI_SUCCESS)
         murk_printable(mname, sizeof mname, nm.data);
-    float al[3], sp[3], r = 0.5f, e[3] = {0, 0, 0}, strength = 1.0f;
-    ggx_of(m, al, sp, &r);
-    if (get_colour(m, AI_MATKEY_COLOR_EMISSIVE, e))
-        get_float(m, AI_MATKEY_EMISSIVE_INTENSITY, &strength);
+    snprintf(label, sizeof label, "%s#%u '%s'", a->name, i, mname);
+    char mlabel[200];
+    snprintf(mlabel, sizeof mlabel, "%u '%s'", i, mname);
+    float al[3], sp[3], r = 0.5f, e[3] = {0, 0, 0}, strength = 1.0f, base[3], metallic;
+    int pbr = ggx_of(m, al, sp, &r, base, &metallic);
+    if (get_colour(m, AI_MATKEY_COLOR_EMISSIVE, e) && !get_float(m, AI_MATKEY_EMISSIVE_INTENSITY, &strength))
+        strength = strength_of(a, mname, mlabel); /* KHR_materials_emissive_strength, read by murk */
     for (int c = 0; c < 3; c++)
         e[c] = e[c] > 0.0f && strength > 0.0f ? fminf(e[c] * strength, 1e30f) : 0.0f;
-    if (!a->textures_noted && (aiGetMaterialTextureCount(m, aiTextureType_DIFFUSE) || aiGetMaterialTextureCount(m, aiTextureType_BASE_COLOR))) {
-        murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: textures of the file's materials are not read; their colour factors are "
-                 "used", a->file->file, a->file->line, a->file->col, a->name);
-        a->textures_noted = 1;
+    /* the textures: glTF's base colour (sRGB) and metallic-roughness (linear: roughness in G, metallic in B;
+     * Assimp's glTF importer files it under aiTextureType_UNKNOWN), other formats' diffuse map; emission */
+    const murk_texture *bt = NULL, *mrt = NULL, *et = NULL;
+    if (file_texture(a, m, pbr ? aiTextureType_BASE_COLOR : aiTextureType_DIFFUSE, "base colour texture", mlabel, 1,
+                     &bt, err, errlen) ||
+        (pbr && !bt && file_texture(a, m, aiTextureType_DIFFUSE, "base colour texture", mlabel, 1, &bt, err, errlen)) ||
+        (pbr && file_texture(a, m, aiTextureType_UNKNOWN, "metallicRoughness texture", mlabel, 0, &mrt, err, errlen)) ||
+        file_texture(a, m, aiTextureType_EMISSIVE, "emissive texture", mlabel, 1, &et, err, errlen))
+        return NULL;
+    if (!a->noted_unread && (aiGetMaterialTextureCount(m, aiTextureType_NORMALS) ||
+                             aiGetMaterialTextureCount(m, aiTextureType_LIGHTMAP))) {
+        murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: normal and occlusion textures are not read", AT(a), mlabel);
+        a->noted_unread = 1;
     }
-    char text[512], label[400];
+    if (mrt && !a->noted_mix++)
+        murk_log(MURK_LOG_WARN, "%s:%d:%d: %s: material %s: metallic texture mapped per hit onto ggx (albedo = base "
+                 "(1 - metallic), specular = mix(0.04, base, metallic)); ggx's diffuse under its coat differs from "
+                 "glTF's (README, Assets)", AT(a), mlabel);
+    murk_param_texture tex[3];
+    size_t ntex = 0;
+    float unit[3] = {1.0f, 1.0f, 1.0f};
+    for (int c = 0; c < 3; c++)
+        base[c] = pbr ? base[c] : al[c];
+    if (bt || mrt) {
+        tex[ntex++] = (murk_param_texture){"albedo", murk_scene_keep_texture(a->s, murk_texture_gltf(
+                                                        MURK_GLTF_ALBEDO, bt, base, mrt, pbr ? metallic : 0.0f, r))};
+        if (pbr)
+            tex[ntex++] = (murk_param_texture){"specular", murk_scene_keep_texture(a->s, murk_texture_gltf(
+                                                              MURK_GLTF_SPECULAR, bt, base, mrt, metallic, r))};
+    }
+    if (mrt)
+        tex[ntex++] = (murk_param_texture){"roughness", murk_scene_keep_texture(a->s, murk_texture_gltf(
+                                                           MURK_GLTF_ROUGHNESS, NULL, unit, mrt, metallic, r))};
+    char text[512];
     snprintf(text, sizeof text, "{ type: ggx, albedo: [%.9g, %.9g, %.9g], specular: [%.9g, %.9g, %.9g], roughness: %.9g }",
              (double)al[0], (double)al[1], (double)al[2], (double)sp[0], (double)sp[1], (double)sp[2], (double)r);
-    snprintf(label, sizeof label, "%s#%u '%s'", a->name, i, mname);
     murk_named_material *nmat = murk_xmalloc(sizeof *nmat);
     murk_ydoc *doc = murk_xmalloc(sizeof *doc);
     const murk_plugin *p = NULL;
     void *self = NULL;
-    static const char *const skip[] = {"type"};
     char who[480];
     snprintf(who, sizeof who, "material %s (ggx, from the file)", label);
     if (murk_ydoc_load_string(doc, text, label, err, errlen) ||
-        murk_scene_instantiate(a->s, a->host, MURK_KIND_MATERIAL, murk_ymap_get(doc->root, "type"), "ggx", doc->root,
-                               who, who, skip, 1, NULL, &p, &self, err, errlen)) {
+        murk_scene_instantiate_textured(a->s, a->host, MURK_KIND_MATERIAL, murk_ymap_get(doc->root, "type"), "ggx",
+                                        doc->root, who, tex, ntex, &p, &self, err, errlen)) {
         murk_ydoc_free(doc);
         free(doc);
         free(nmat);
@@ -237,6 +561,7 @@ static const murk_material *file_material(asset_ctx *a, unsigned i, murk_rgb *em
     s->asset_docs[s->nasset_materials++] = doc;
     a->made[i] = &nmat->m;
     a->made_emission[i] = *emission = murk_rgb3(e[0], e[1], e[2]);
+    a->made_emission_tex[i] = *etex = murk_rgb_is_black(*emission) ? NULL : et;
     return a->made[i];
 }
 
@@ -324,13 +649,14 @@ static int add_mesh(asset_ctx *a, unsigned mi, const xform *x, char *err, size_t
     sh->exterior = a->exterior;
     if (a->from_file) {
         murk_rgb e;
+        const murk_texture *et;
         if (me->mMaterialIndex >= a->ai->mNumMaterials)
             return ERR(a->file, "%s: mesh '%s' names material %u of %u", a->name, me->mName.data, me->mMaterialIndex,
                        a->ai->mNumMaterials);
-        if (!(sh->material = file_material(a, me->mMaterialIndex, &e, err, errlen)))
+        if (!(sh->material = file_material(a, me->mMaterialIndex, &e, &et, err, errlen)))
             return -1;
         if (!a->have_emission)
-            sh->emission = e;
+            sh->emission = e, sh->emission_tex = et;
     }
     return 0;
 }
@@ -388,8 +714,9 @@ static int add_lights(asset_ctx *a, double scale, char *err, size_t errlen)
         murk_vec3 pos = murk_v3((float)wp[0], (float)wp[1], (float)wp[2]), dir = murk_v3((float)wd[0], (float)wd[1], (float)wd[2]);
         murk_rgb I = murk_rgb3((float)(l->mColorDiffuse.r * scale), (float)(l->mColorDiffuse.g * scale),
                                (float)(l->mColorDiffuse.b * scale));
-        char lerr[512] = "";
+        char lerr[512] = "", lname[160];
         int rc = 0;
+        size_t before = a->s->nadded;
         if (l->mType == aiLightSource_POINT)
             rc = murk_lights_add_point(a->s, pos, I, lerr, sizeof lerr);
         else if (l->mType == aiLightSource_SPOT)
@@ -402,6 +729,8 @@ static int add_lights(asset_ctx *a, double scale, char *err, size_t errlen)
                      a->file->file, a->file->line, a->file->col, a->name, l->mName.data);
         if (rc)
             return ERR(a->file, "%s: light '%s': %s", a->name, l->mName.data, lerr);
+        murk_load_note_lights(a->s, before, "%s light '%s' (%s:%d:%d)", a->name, murk_printable(lname, sizeof lname,
+                              l->mName.data), a->file->file, a->file->line, a->file->col);
     }
     return 0;
 }
@@ -442,6 +771,23 @@ static int take_camera(asset_ctx *a, const char *want, murk_asset_camera *cam, c
         return ERR(a->file, "%s: camera '%s' has a field of view of %g degrees; murk takes (0.01, 179)", a->name,
                    c->mName.data, (double)cam->fov);
     return 0;
+}
+
+/* 1 if the PLY file at path has a line "end_header": Debian's Assimp 5.2.5 reads a header without one forever
+ * (found by tests/fuzz: fuzz_asset; the seed corpus keeps the input, ply_no_end_header). */
+static int ply_header_ends(const char *path)
+{
+    uint64_t size;
+    char ferr[512];
+    unsigned char *b = murk_file_read_all(path, &size, ferr, sizeof ferr);
+    if (!b)
+        return 1; /* Assimp's own open reports it */
+    int found = 0;
+    for (uint64_t i = 0; !found && i + 10 <= size; i++)
+        found = (i == 0 || b[i - 1] == '\n') && !memcmp(b + i, "end_header", 10) &&
+                (i + 10 == size || b[i + 10] == '\n' || b[i + 10] == '\r');
+    free(b);
+    return found;
 }
 #endif
 
@@ -513,19 +859,51 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
         return ERR(f, "asset: %s", ferr);
     }
     fclose(fp);
+    if (a.from_file && (ends_with(file, ".gltf") || ends_with(file, ".glb"))) {
+        unsigned char *bytes = murk_file_read_all(path, &size, ferr, sizeof ferr);
+        if (bytes)
+            a.strength = emissive_strengths(bytes, (size_t)size, &a.nstrength);
+        free(bytes);
+    }
+    if (ends_with(file, ".ply") && !ply_header_ends(path)) {
+        free(path);
+        free(a.strength);
+        return ERR(f, "asset: %s: its PLY header has no 'end_header' line (Assimp 5.2 would read on without end)", file);
+    }
     struct aiPropertyStore *props = aiCreatePropertyStore();
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    a.ai = aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
-                                        aiProcess_ValidateDataStructure, NULL, props);
+    /* read first without post-processing, to refuse a face without vertices (a PLY face list of 0), on which
+     * Debian's Assimp 5.2 aborts in its Triangulate step (an ai_assert; found by tests/fuzz, seed ply_empty_face);
+     * then read again with the steps. Not aiApplyPostProcessing on the first scene: when its validation fails
+     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release). */
+    const struct aiScene *probe = aiImportFileExWithProperties(path, 0, NULL, props);
+    char bad[300] = "";
+    for (unsigned m = 0; probe && m < probe->mNumMeshes && !bad[0]; m++)
+        for (unsigned k = 0; probe->mMeshes[m] && probe->mMeshes[m]->mFaces && k < probe->mMeshes[m]->mNumFaces && !bad[0]; k++)
+            if (probe->mMeshes[m]->mFaces[k].mNumIndices == 0 || !probe->mMeshes[m]->mFaces[k].mIndices)
+                snprintf(bad, sizeof bad, "mesh %u face %u has no vertices", m, k);
+    if (probe)
+        aiReleaseImport(probe);
+    if (bad[0]) {
+        aiReleasePropertyStore(props);
+        free(path);
+        free(a.strength);
+        return ERR(f, "asset: %s: %s", file, bad);
+    }
+    a.ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
+                                                aiProcess_ValidateDataStructure, NULL, props) : NULL;
     aiReleasePropertyStore(props);
-    free(path);
+    a.path = path;
     if (!a.ai) {
         char msg[512];
+        free(path);
+        free(a.strength);
         return ERR(f, "asset: %s: Assimp cannot read it: %s", file, murk_printable(msg, sizeof msg, aiGetErrorString()));
     }
     int rc = 0;
     a.made = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made);
     a.made_emission = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made_emission);
+    a.made_emission_tex = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made_emission_tex);
     size_t before = s->nshapes;
     if (!a.ai->mRootNode)
         rc = ERR(f, "asset: %s has no node hierarchy", file);
@@ -541,6 +919,10 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
         rc = take_camera(&a, camera, cam, err, errlen);
     free(a.made);
     free(a.made_emission);
+    free(a.made_emission_tex);
+    free(a.strength);
+    free(a.cache);
+    free(a.path);
     aiReleaseImport(a.ai);
     return rc;
 #endif

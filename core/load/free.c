@@ -57,6 +57,12 @@ MURK_API void murk_scene_free(murk_scene *s)
     free(s->lights);
     free(s->light_cdf);
     free(s->added);
+    for (size_t i = 0; i < s->nlight_origins; i++)
+        free(s->light_origins[i].where);
+    free(s->light_origins);
+    for (size_t i = 0; i < s->nasset_inputs; i++)
+        free(s->asset_inputs[i]);
+    free(s->asset_inputs);
     free(s->env);
     for (size_t i = 0; i < s->nenvmaps; i++)
         murk_envmap_free(s->envmaps[i]);

@@ -16,6 +16,7 @@
 #include "yaml/yread.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -180,12 +181,27 @@ static int load_light(murk_scene *s, const murk_ynode *n, size_t i, char *err, s
     size_t before = s->nadded;
     int rc = k <= 1 ? load_punctual(&c, k == 1, err, errlen) : k == 2 ? load_distant(&c, err, errlen)
              : k == 3 ? load_envmap(&c, err, errlen) : load_sky(&c, err, errlen);
+    if (rc == 0)
+        murk_load_note_lights(s, before, "%s:%d:%d lights[%zu]", n->file, n->line, n->col, i);
     for (size_t j = before; rc == 0 && s->legacy_lights && j < s->nadded; j++)
         if (!murk_light_is_env(&s->added[j]))
             return ERR(t, "%s: the integrator predates plugin ABI 1.%d and cannot sample a delta light (point, spot, "
                        "distant with angular_diameter 0), which nothing else can reach: rebuild it against this murk",
                        c.who, MURK_ABI_MINOR_LIGHTS);
     return rc;
+}
+
+void murk_load_note_lights(murk_scene *s, size_t before, const char *fmt, ...)
+{
+    if (s->nadded <= before)
+        return;
+    char where[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(where, sizeof where, fmt, ap);
+    va_end(ap);
+    s->light_origins = murk_xrealloc(s->light_origins, (s->nlight_origins + 1) * sizeof *s->light_origins);
+    s->light_origins[s->nlight_origins++] = (struct murk_light_origin){before, s->nadded - before, murk_strdup(where)};
 }
 
 int murk_load_lights(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)

@@ -19,6 +19,8 @@ uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen);
 /* The `lights:` list (light_block.c): each light checked and added (render/lights.h). 0, or -1 with a
  * located err. */
 int murk_load_lights(murk_scene *s, const murk_ynode *n, char *err, size_t errlen);
+/* Records that the lights added since s->nadded was `before` came from where (printf format), for murk info. */
+void murk_load_note_lights(murk_scene *s, size_t before, const char *fmt, ...) MURK_PRINTF(3, 4);
 
 /* Releases what a shape owns (its triangle arrays). */
 void murk_shape_free(murk_shape *sh);

@@ -83,6 +83,16 @@ std::string coord(const openvdb::Coord &c)
     return "(" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) + ")";
 }
 
+/* A name from the file as a message may show it: at most 60 bytes, anything but printable ASCII as '?'. */
+std::string printable(const std::string &s)
+{
+    std::string out = s.substr(0, 60);
+    for (char &c : out)
+        if (c < 0x20 || c > 0x7e)
+            c = '?';
+    return out;
+}
+
 /* The names of the file's grids, quoted and comma-separated. */
 std::string grid_names(openvdb::io::File &file)
 {
@@ -171,9 +181,20 @@ private:
         uint32_t n = u32();
         need(12ull * n, what + " (" + std::to_string(n) + " entries)");
         for (uint32_t i = 0; i < n; i++) {
-            str(what + ": a name");
-            str(what + ": a type name");
-            skip(u32(), what + ": a value");
+            std::string name = str(what + ": a name"), type = str(what + ": a type name");
+            uint32_t bytes = u32();
+            /* libopenvdb reads a registered fixed-size type's value by its type's size, whatever the byte count
+             * says: a count that differs would put its stream elsewhere than this walk (found by fuzz_vdb: a
+             * string length then read from the middle of a value, 1.7 GB; seed vdb/meta_size_mismatch) */
+            static const struct { const char *type; uint32_t bytes; } fixed[] = {
+                {"bool", 1}, {"int32", 4}, {"int64", 8}, {"float", 4}, {"double", 8}, {"vec2i", 8}, {"vec2s", 8},
+                {"vec2d", 16}, {"vec3i", 12}, {"vec3s", 12}, {"vec3d", 24}, {"vec4i", 16}, {"vec4s", 16},
+                {"vec4d", 32}, {"mat4s", 64}, {"mat4d", 128}};
+            for (const auto &f : fixed)
+                if (type == f.type && bytes != f.bytes)
+                    throw Failure{what + ": '" + printable(name) + "' is a " + type + " of " + std::to_string(bytes) +
+                                  " bytes; a " + type + " has " + std::to_string(f.bytes)};
+            skip(bytes, what + ": a value");
         }
     }
     /* A grid descriptor and the head of its grid: metadata, transform, root counts. */

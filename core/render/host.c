@@ -96,6 +96,11 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
     h->interior = sh->interior;
     h->exterior = sh->exterior;
     h->emission = sh->emission;
+    if (sh->emission_tex) {
+        float t[3];
+        murk_texture_eval(sh->emission_tex, h, t);
+        h->emission = murk_rgb3(sh->emission.c[0] * t[0], sh->emission.c[1] * t[1], sh->emission.c[2] * t[2]);
+    }
     h->light = sh->light_base < 0 ? -1 : sh->light_base + (sh->type == MURK_SHAPE_SPHERE ? 0 : (int32_t)h->prim);
 }
 

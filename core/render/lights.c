@@ -10,6 +10,7 @@
  * (a hit on the light itself): those sample it by area, and murk_lights_pdf() follows the same rule. */
 #include "render/lights.h"
 #include "render/accel.h"
+#include "scene/texture.h"
 #include "util/error.h"
 #include "util/util.h"
 
@@ -81,6 +82,12 @@ static void shape_lights(murk_scene *s, size_t *cap)
         murk_light l = {0};
         l.geom = (uint32_t)i;
         l.le = sh->emission;
+        if (sh->emission_tex) { /* its mean for the choice by power; its value where a sample lands */
+            double m[3];
+            murk_texture_average(sh->emission_tex, m);
+            l.le = murk_rgb3(sh->emission.c[0] * (float)m[0], sh->emission.c[1] * (float)m[1], sh->emission.c[2] * (float)m[2]);
+            l.textured = 1;
+        }
         if (sh->type == MURK_SHAPE_SPHERE) {
             l.kind = MURK_LK_SPHERE;
             l.center = sh->center;
@@ -294,6 +301,29 @@ static MURK_NOINLINE int sample_rect(const murk_light *l, murk_vec3 p, const flo
     return isfinite(ls->pdf) && ls->pdf > 0.0f;
 }
 
+/* The emission of a textured triangle light at barycentrics (b1, b2): its shape's emission times the
+ * texture at the point's (u, v), as host.c's fill_hit gives a hit there. Only meshes are textured, and a
+ * mesh's triangles are never sampled as rectangles. */
+static MURK_NOINLINE murk_rgb textured_le(const murk_scene *s, const murk_light *l, float b1, float b2)
+{
+    const murk_shape *sh = &s->shapes[l->geom];
+    murk_hit h;
+    memset(&h, 0, sizeof h);
+    const uint32_t *ix = &sh->idx[3 * l->prim];
+    float b0 = 1.0f - b1 - b2;
+    if (sh->uv) {
+        const float *t0 = &sh->uv[2 * ix[0]], *t1 = &sh->uv[2 * ix[1]], *t2 = &sh->uv[2 * ix[2]];
+        h.u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
+        h.v = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
+    } else {
+        h.u = b1;
+        h.v = b2;
+    }
+    float t[3];
+    murk_texture_eval(sh->emission_tex, &h, t);
+    return murk_rgb3(sh->emission.c[0] * t[0], sh->emission.c[1] * t[1], sh->emission.c[2] * t[2]);
+}
+
 int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int strategy, murk_light_sample *ls)
 {
     memset(ls, 0, sizeof *ls);
@@ -320,12 +350,14 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
             return ok;
     }
     murk_vec3 q;
+    float b1 = 0.0f, b2 = 0.0f; /* q's barycentrics in the triangle (not for a rectangle) */
     if (l->rect) { /* the whole rectangle, uniformly: the same density as its triangle's (both carry
                     * pmf / area), but the 2-D point keeps the sampler's stratification over the lamp */
         q = murk_add(l->rp0, murk_add(murk_mul(l->rex, u[1]), murk_mul(l->rey, u[2])));
     } else {
         float su = sqrtf(u[1]);
-        q = murk_add(l->p0, murk_add(murk_mul(l->e1, su * (1.0f - u[2])), murk_mul(l->e2, su * u[2])));
+        b1 = su * (1.0f - u[2]), b2 = su * u[2];
+        q = murk_add(l->p0, murk_add(murk_mul(l->e1, b1), murk_mul(l->e2, b2)));
     }
     murk_vec3 d = murk_sub(q, p);
     float dist2 = murk_dot(d, d), dist = sqrtf(dist2);
@@ -337,7 +369,7 @@ int murk_lights_sample(const murk_scene *s, murk_vec3 p, const float u[3], int s
         return 0;
     ls->wi = wi;
     ls->dist = dist;
-    ls->le = l->le;
+    ls->le = l->textured ? textured_le(s, l, b1, b2) : l->le;
     ls->pdf = l->pmf * dist2 / (cosl * l->area);
     return isfinite(ls->pdf) && ls->pdf > 0.0f;
 }

@@ -104,6 +104,13 @@ static int unknown_key(const murk_plugin_desc *d, const murk_ynode *map, size_t 
     return murk_yerr_key(err, errlen, map, k, "unknown parameter '%s' for %s (%s)", key, who, hint);
 }
 
+murk_texture *murk_scene_keep_texture(murk_scene *s, murk_texture *t)
+{
+    s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
+    s->textures[s->ntextures++] = t;
+    return t;
+}
+
 /* A float or colour parameter given as a texture (a map): parsed, kept by the scene, its average as the
  * plain value. 0, or -1 with "LOCATION: WHAT: message" in err. */
 static int read_texture(murk_scene *s, const murk_param *p, murk_value *v, const murk_ynode *n, const char *what,
@@ -117,9 +124,7 @@ static int read_texture(murk_scene *s, const murk_param *p, murk_value *v, const
         snprintf(err, errlen, "%s", msg);
         return -1;
     }
-    s->textures = murk_xrealloc(s->textures, (s->ntextures + 1) * sizeof *s->textures);
-    s->textures[s->ntextures++] = t;
-    v->tex = t;
+    v->tex = murk_scene_keep_texture(s, t);
     murk_texture_average(t, v->f);
     return 0;
 }
@@ -223,10 +228,11 @@ int murk_scene_read_plugin_params(murk_scene *s, const murk_plugin_desc *d, cons
     return 0;
 }
 
-int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node,
-                           const char *type, const murk_ynode *map, const char *block, const char *who,
-                           const char *const *skip, size_t nskip, const murk_medium_data *data,
-                           const murk_plugin **plugin, void **self, char *err, size_t errlen)
+/* murk_scene_instantiate (params.h), with the textures tex[] in place of their parameters' values. */
+static int instantiate(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node, const char *type,
+                       const murk_ynode *map, const char *block, const char *who, const char *const *skip,
+                       size_t nskip, const murk_medium_data *data, const murk_param_texture *tex, size_t ntex,
+                       const murk_plugin **plugin, void **self, char *err, size_t errlen)
 {
     char lerr[1024];
     const murk_plugin *p = murk_registry_load(&s->reg, kind, type, lerr, sizeof lerr);
@@ -235,6 +241,16 @@ int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const
     murk_value *vals = murk_scene_keep_params(s, p->desc->nparams);
     if (murk_scene_read_plugin_params(s, p->desc, map, who, skip, nskip, 1, vals, err, errlen))
         return -1;
+    for (size_t k = 0; k < ntex; k++) {
+        uint32_t i = 0;
+        while (i < p->desc->nparams && strcmp(p->desc->params[i].name, tex[k].name))
+            i++;
+        if (i == p->desc->nparams || !(p->desc->params[i].flags & MURK_PARAM_TEXTURABLE))
+            return ERR(map, "%s: no texturable parameter '%s'", who, tex[k].name);
+        vals[i].set = 1;
+        vals[i].tex = tex[k].tex;
+        murk_texture_average(tex[k].tex, vals[i].f);
+    }
     char cerr[512] = "";
     int rc;
     switch (kind) {
@@ -257,4 +273,22 @@ int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const
     }
     *plugin = p;
     return 0;
+}
+
+int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node,
+                           const char *type, const murk_ynode *map, const char *block, const char *who,
+                           const char *const *skip, size_t nskip, const murk_medium_data *data,
+                           const murk_plugin **plugin, void **self, char *err, size_t errlen)
+{
+    return instantiate(s, host, kind, type_node, type, map, block, who, skip, nskip, data, NULL, 0, plugin, self, err,
+                       errlen);
+}
+
+int murk_scene_instantiate_textured(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node,
+                                    const char *type, const murk_ynode *map, const char *who,
+                                    const murk_param_texture *tex, size_t ntex, const murk_plugin **plugin, void **self,
+                                    char *err, size_t errlen)
+{
+    static const char *const skip[] = {"type"};
+    return instantiate(s, host, kind, type_node, type, map, who, who, skip, 1, NULL, tex, ntex, plugin, self, err, errlen);
 }

@@ -35,4 +35,16 @@ int murk_scene_instantiate(murk_scene *s, const murk_host *host, int kind, const
                            const char *const *skip, size_t nskip, const murk_medium_data *data,
                            const murk_plugin **plugin, void **self, char *err, size_t errlen);
 
+/* A parameter given a texture made in C (load/asset.c: the textures of a file's material) instead of
+ * what the map says. */
+typedef struct murk_param_texture { const char *name; const murk_texture *tex; } murk_param_texture;
+/* murk_scene_instantiate, with the parameters named in tex[] (texturable ones) taking those textures,
+ * their averages as plain values, before create(). */
+int murk_scene_instantiate_textured(murk_scene *s, const murk_host *host, int kind, const murk_ynode *type_node,
+                                    const char *type, const murk_ynode *map, const char *who,
+                                    const murk_param_texture *tex, size_t ntex, const murk_plugin **plugin, void **self,
+                                    char *err, size_t errlen);
+/* Hands t to the scene, which frees it with itself; returns t. */
+murk_texture *murk_scene_keep_texture(murk_scene *s, murk_texture *t);
+
 #endif

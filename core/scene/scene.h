@@ -12,6 +12,8 @@
 #include "plugin/plugin_loader.h"
 #include "yaml/yamldoc.h"
 
+struct murk_texture;
+
 typedef enum { MURK_SHAPE_QUAD, MURK_SHAPE_SPHERE, MURK_SHAPE_BOX, MURK_SHAPE_MESH } murk_shape_type;
 
 typedef struct murk_shape {
@@ -19,6 +21,8 @@ typedef struct murk_shape {
     const murk_material *material;             /* NULL: medium boundary only */
     const murk_medium *interior, *exterior;
     murk_rgb emission;
+    const struct murk_texture *emission_tex;   /* a mesh's emission is emission x this at (u, v); NULL: constant
+                                                * (load/asset.c: a glTF emissiveTexture; the scene keeps it) */
     int32_t light_base;                        /* light index of primitive 0, or -1 */
     uint32_t nverts, ntris;
     float *pos;                                /* 3*nverts (triangle shapes) */
@@ -60,6 +64,7 @@ typedef struct murk_light {
     /* a triangle of a rectangle (a quad or box face: two triangles): the rectangle p0 + a ex + b ey,
      * a, b in [0, 1], and the probability of picking either of its triangles (MURK_LIGHT_SOLID_ANGLE) */
     int rect;
+    int textured; /* a triangle of a shape with an emission texture: le is its mean, ls.le its value */
     murk_vec3 rp0, rex, rey;
     float rect_pmf;
 } murk_light;
@@ -100,6 +105,8 @@ struct murk_scene {
     murk_named_material **asset_materials;
     struct murk_ydoc **asset_docs;
     size_t nasset_materials;
+    char **asset_inputs; /* the files an asset loaded beside itself (its PNG textures), for the content hash */
+    size_t nasset_inputs;
     murk_named_medium *media;
     size_t nmedia;
     const murk_plugin *integrator_plugin;
@@ -121,6 +128,9 @@ struct murk_scene {
      * `lights`; the environment maps they own */
     murk_light *added;
     size_t nadded;
+    /* where added lights came from, for murk info: added[first .. first + n) from `where` (owned) */
+    struct murk_light_origin { size_t first, n; char *where; } *light_origins;
+    size_t nlight_origins;
     murk_envmap **envmaps;
     size_t nenvmaps;
     /* the environment's parts (indices into lights: envmaps, finite-cone distant lights, and the constant

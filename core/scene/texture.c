@@ -1,4 +1,5 @@
-/* texture.c — constant, checkerboard and PNG image textures (see texture.h for the scene syntax). */
+/* texture.c — constant, checkerboard and PNG image textures (see texture.h for the scene syntax), and the
+ * parameters of a glTF metallic-roughness material computed from its textures (load/asset.c). */
 #include "scene/texture.h"
 #include "image/image.h"
 #include "util/util.h"
@@ -9,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum { TEX_CHECKER, TEX_IMAGE } tex_kind;
+typedef enum { TEX_CHECKER, TEX_IMAGE, TEX_GLTF } tex_kind;
 
 struct murk_texture {
     tex_kind kind;
@@ -18,6 +19,10 @@ struct murk_texture {
     murk_image img;   /* TEX_IMAGE */
     char file[256];   /* TEX_IMAGE: the file as the scene names it */
     double avg[3];
+    /* TEX_GLTF: which parameter, the textures it reads (not owned) and the factors */
+    murk_gltf_param which;
+    const murk_texture *base, *mr;
+    float base_factor[3], metallic, roughness;
 };
 
 static int colour(const murk_ynode *n, const char *what, double lo, double hi, float out[3], char *err, size_t errlen)
@@ -45,6 +50,16 @@ static int scale2(const murk_ynode *n, float *su, float *sv, char *err, size_t e
     *su = (float)a;
     *sv = (float)b;
     return 0;
+}
+
+static void image_average(murk_texture *t)
+{
+    size_t np = (size_t)t->img.w * (size_t)t->img.h;
+    for (size_t i = 0; i < np; i++)
+        for (int ch = 0; ch < 3; ch++)
+            t->avg[ch] += t->img.rgb[3 * i + (size_t)ch];
+    for (int ch = 0; ch < 3; ch++)
+        t->avg[ch] /= (double)(np ? np : 1);
 }
 
 murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, double lo, double hi, char *err,
@@ -102,12 +117,7 @@ murk_texture *murk_texture_parse(const murk_ynode *n, const char *scene_path, do
             murk_yerr(err, errlen, f, "image texture: %s", ierr);
             goto fail;
         }
-        size_t np = (size_t)t->img.w * (size_t)t->img.h;
-        for (size_t i = 0; i < np; i++)
-            for (int ch = 0; ch < 3; ch++)
-                t->avg[ch] += t->img.rgb[3 * i + (size_t)ch];
-        for (int ch = 0; ch < 3; ch++)
-            t->avg[ch] /= (double)(np ? np : 1);
+        image_average(t);
         return t;
     }
     murk_yerr(err, errlen, k, "unknown texture '%s' (expected checker or image)", k->str);
@@ -122,8 +132,34 @@ static int wrap(int i, int n)
     return r < 0 ? r + n : r;
 }
 
+static float clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+/* A TEX_GLTF texture's value at (u, v) (texture.h): the textures are sampled first, then mixed, as the
+ * glTF specification's BRDF does. */
+static void gltf_eval(const murk_texture *t, const murk_hit *hit, float out[3])
+{
+    float b[3] = {1.0f, 1.0f, 1.0f}, mr[3] = {1.0f, 1.0f, 1.0f};
+    if (t->mr)
+        murk_texture_eval(t->mr, hit, mr);
+    float m = clamp01(mr[2] * t->metallic);
+    if (t->which == MURK_GLTF_ROUGHNESS) {
+        out[0] = out[1] = out[2] = clamp01(mr[1] * t->roughness);
+        return;
+    }
+    if (t->base)
+        murk_texture_eval(t->base, hit, b);
+    for (int c = 0; c < 3; c++) {
+        float base = clamp01(b[c] * t->base_factor[c]);
+        out[c] = clamp01(t->which == MURK_GLTF_ALBEDO ? base * (1.0f - m) : 0.04f * (1.0f - m) + base * m);
+    }
+}
+
 void murk_texture_eval(const murk_texture *t, const murk_hit *hit, float out[3])
 {
+    if (t->kind == TEX_GLTF) {
+        gltf_eval(t, hit, out);
+        return;
+    }
     float u = hit->u * t->su, v = hit->v * t->sv;
     if (t->kind == TEX_CHECKER) {
         long parity = ((long)floorf(u) + (long)floorf(v)) & 1;
@@ -150,12 +186,61 @@ void murk_texture_eval(const murk_texture *t, const murk_hit *hit, float out[3])
     }
 }
 
+murk_texture *murk_texture_from_image(murk_image *img, const char *name)
+{
+    murk_texture *t = murk_xmalloc(sizeof *t); /* zeroed */
+    t->kind = TEX_IMAGE;
+    t->su = t->sv = 1.0f;
+    t->img = *img;
+    memset(img, 0, sizeof *img);
+    snprintf(t->file, sizeof t->file, "%s", name);
+    image_average(t);
+    return t;
+}
+
+murk_texture *murk_texture_gltf(murk_gltf_param which, const murk_texture *base, const float base_factor[3],
+                                const murk_texture *mr, float metallic, float roughness)
+{
+    murk_texture *t = murk_xmalloc(sizeof *t); /* zeroed */
+    t->kind = TEX_GLTF;
+    t->which = which;
+    t->base = base;
+    t->mr = mr;
+    memcpy(t->base_factor, base_factor, sizeof t->base_factor);
+    t->metallic = metallic;
+    t->roughness = roughness;
+    snprintf(t->file, sizeof t->file, "glTF %s", which == MURK_GLTF_ALBEDO ? "albedo" : which == MURK_GLTF_SPECULAR
+             ? "specular" : "roughness");
+    /* the plain value (murk_value.f): the mean over a grid of points in [0,1)^2, as fine as the larger image
+     * (at most 512 x 512 points) */
+    int n = 1;
+    if (base)
+        n = base->img.w > n ? base->img.w : n, n = base->img.h > n ? base->img.h : n;
+    if (mr)
+        n = mr->img.w > n ? mr->img.w : n, n = mr->img.h > n ? mr->img.h : n;
+    n = n < 512 ? n : 512;
+    murk_hit h;
+    memset(&h, 0, sizeof h);
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++) {
+            float v[3];
+            h.u = ((float)x + 0.5f) / (float)n;
+            h.v = ((float)y + 0.5f) / (float)n;
+            gltf_eval(t, &h, v);
+            for (int c = 0; c < 3; c++)
+                t->avg[c] += v[c];
+        }
+    for (int c = 0; c < 3; c++)
+        t->avg[c] /= (double)n * n;
+    return t;
+}
+
 void murk_texture_average(const murk_texture *t, double out[3]) { memcpy(out, t->avg, sizeof t->avg); }
 
 size_t murk_texture_bytes(const murk_texture *t, const char **name)
 {
     if (name)
-        *name = t->kind == TEX_IMAGE ? t->file : "checker";
+        *name = t->kind == TEX_CHECKER ? "checker" : t->file;
     return sizeof *t + (t->kind == TEX_IMAGE ? 3 * (size_t)t->img.w * (size_t)t->img.h * sizeof(float) : 0);
 }
 
