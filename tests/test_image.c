@@ -801,6 +801,23 @@ static void test_png_broken_files(void **state)
         spit(cut, bytes, len);
         assert_failed_cleanly(murk_png_read(cut, 1, &img, err, sizeof err), &img, cut);
     }
+    /* A text chunk claiming far more bytes than the file holds: refused before libpng sizes a buffer by it
+       (libpng allocated the claimed 1.6 GB first; a fuzz finding). */
+    {
+        unsigned char *t = NULL;
+        for (size_t i = 8; i + 4 <= n && !t; i++)
+            if (memcmp(bytes + i, "tEXt", 4) == 0)
+                t = bytes + i;
+        assert_non_null(t);
+        unsigned char keep[4];
+        memcpy(keep, t - 4, 4);
+        memcpy(t - 4, "\x61\x62\x63\x64", 4);
+        spit(cut, bytes, n);
+        assert_failed_cleanly(murk_png_read(cut, 1, &img, err, sizeof err), &img, cut);
+        assert_non_null(strstr(err, "chunk 'tEXt' at byte"));
+        assert_non_null(strstr(err, "claims 1633837924 bytes"));
+        memcpy(t - 4, keep, 4);
+    }
     /* A flipped byte in the image data breaks its CRC. */
     bytes[n / 2] ^= 0x40;
     spit(cut, bytes, n);

@@ -204,6 +204,39 @@ static int png_decode(png_job *j)
     return png_copy_text(j);
 }
 
+/* The chunk framing of the PNG open as fp, before libpng sees it: from byte 8 on, every chunk's 12 bytes of
+ * length, type and CRC plus its declared length must fit in the file, up to IEND. libpng allocates a chunk's
+ * declared length before reading it (a text chunk claiming 1.7 GB in a 240-byte file took that much memory),
+ * so no allocation may be sized by a length the file cannot hold. Leaves fp at byte 8; 0 or -1 with msg. */
+static int png_check_framing(FILE *fp, uint64_t size, char *msg, size_t msglen)
+{
+    uint64_t at = 8;
+    for (;;) {
+        unsigned char h[8];
+        if (size - at < 12 || fseek(fp, (long)at, SEEK_SET) != 0 || fread(h, 1, sizeof h, fp) != sizeof h) {
+            snprintf(msg, msglen, "the file ends at byte %llu before its IEND chunk", (unsigned long long)size);
+            return -1;
+        }
+        uint64_t len = (uint64_t)h[0] << 24 | (uint64_t)h[1] << 16 | (uint64_t)h[2] << 8 | h[3];
+        char type[5] = {0};
+        for (int i = 0; i < 4; i++)
+            type[i] = (h[4 + i] >= 'A' && h[4 + i] <= 'z') ? (char)h[4 + i] : '?';
+        if (len > size - at - 12) {
+            snprintf(msg, msglen, "chunk '%s' at byte %llu claims %llu bytes, more than the %llu left in the file",
+                     type, (unsigned long long)at, (unsigned long long)len, (unsigned long long)(size - at - 12));
+            return -1;
+        }
+        at += 12 + len;
+        if (memcmp(h + 4, "IEND", 4) == 0)
+            break;
+    }
+    if (fseek(fp, 8, SEEK_SET) != 0) {
+        snprintf(msg, msglen, "cannot seek in the file");
+        return -1;
+    }
+    return 0;
+}
+
 /* The read of a PNG open as fp (size bytes; closed here), named path in messages. */
 static int png_read_fp(FILE *fp, uint64_t size, const char *path, int srgb, murk_image *img, char *err, size_t errlen)
 {
@@ -218,6 +251,10 @@ static int png_read_fp(FILE *fp, uint64_t size, const char *path, int srgb, murk
     if (fread(sig, 1, sizeof sig, j.fp) != sizeof sig || png_sig_cmp(sig, 0, sizeof sig) != 0) {
         fclose(j.fp);
         return murk_err_file(err, errlen, path, "not a PNG file");
+    }
+    if (png_check_framing(j.fp, size, j.msg, sizeof j.msg) != 0) {
+        fclose(j.fp);
+        return murk_err_file(err, errlen, path, "cannot read PNG: %s", j.msg);
     }
     j.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &j, png_error_cb, png_warning_cb);
     if (j.png)
