@@ -13,7 +13,11 @@
  *               1e-4 and 1e4, albedo 0 and 1: exit 0, every pixel finite, no NaN/inf sample dropped,
  *               and the warnings murk promises.
  *   camera      the camera inside a medium.
- * In the suite 'long' (long_* tests): the furnaces with 16x the samples, and the invariance: one
+ * volpath_nee renders the furnace, the slab and the camera in fog to volpath's image bit for bit (nothing
+ * to sample, or a black emitter that ends the path), and its stability points are stability_quick's (the
+ * atlas's extreme points, every tracker, volpath_nee): the default run renders them with volpath alone.
+ * In the suite 'long' (long_* tests): the furnaces with 16x the samples, the slab, the camera in fog and
+ * the stability points through both integrators, and the invariance: one
  * heterogeneous scene rendered with every tracker, majorant factor 1 and 4 and decomposition control 0,
  * 0.1, 0.5, 1 agrees with the delta-tracking render block by block (img_stack_agree; every
  * configuration its own seeds), and the same comparison against a 1 % denser medium must FAIL.
@@ -202,8 +206,9 @@ static void test_furnace(void **state)
                     check_channels(label, &st, one);
                     murk_image_free(&img);
                 }
-                /* grey sigma_s 2: every weight is exactly 1 except for naive_spectral's 3x hero */
-                if (t == 4)
+                /* grey sigma_s 2: every weight is exactly 1 except for naive_spectral's 3x hero (volpath_nee:
+                 * volpath's image bit for bit, as above; rendered in the suite 'long') */
+                if (t == 4 || (i == 1 && !longrun))
                     continue;
                 render_img(furnace(TRACKERS[t], dens[d], "2", INTEGRATORS[i], 4), out_path("furnace.exr"), &img, NULL,
                            NULL, NULL, NULL);
@@ -270,7 +275,9 @@ static void test_slab(void **state)
     nfail = 0;
     const double expect[3] = {exp(-0.5), exp(-1.0), exp(-2.0)};
     double t0 = now();
-    for (int i = 0; i < 2; i++)
+    /* volpath_nee: volpath's image bit for bit (no scattering, and the black emitter ends the path), in
+     * the suite 'long' */
+    for (int i = 0; i < (longrun ? 2 : 1); i++)
         for (int t = 0; t < NTRACKERS; t++)
             for (int d = 0; d < 2; d++) {
                 /* d = 1: a loose majorant (x3), two thirds of the tentative collisions null */
@@ -393,7 +400,9 @@ static void long_invariance(void **state)
 static void stable(const char *label, const char *tracker_keys, const char *medium_keys, const char *shape,
                    const char *want)
 {
-    for (int i = 0; i < 2; i++) {
+    /* volpath_nee at these points: stability_quick's (the atlas's extreme points through volpath_nee, every
+     * tracker) in the default run; both integrators in the suite 'long' */
+    for (int i = 0; i < (longrun ? 2 : 1); i++) {
         const char *scene = scene_file(
             "stab.yaml",
             "murk: 1\n"
@@ -480,8 +489,9 @@ static void test_camera_inside(void **state)
 {
     (void)state;
     nfail = 0;
+    /* volpath_nee: volpath's image bit for bit (the sky is no light to sample), in the suite 'long' */
     for (size_t t = 0; t < sizeof TRACKERS / sizeof TRACKERS[0]; t++)
-        for (size_t k = 0; k < 2; k++) {
+        for (size_t k = 0; k < (longrun ? 2u : 1u); k++) {
             const char *scene = scene_file("camera_inside.yaml",
                 "murk: 1\n"
                 "render: { resolution: [16, 16], spp: %d, seed: 4 }\n"
@@ -520,24 +530,21 @@ static void test_camera_inside(void **state)
     assert_int_equal(nfail, 0);
 }
 
-static void long_furnace(void **state)
-{
-    longrun = 1;
-    test_furnace(state);
-}
-
-static void long_furnace_nee(void **state)
-{
-    longrun = 1;
-    test_furnace_nee(state);
-}
+/* The suite 'long': the furnaces with 16x the samples; the slab, the camera in fog and the stability
+ * points through volpath_nee too. */
+STAT_LONG_OF(furnace, longrun)
+STAT_LONG_OF(furnace_nee, longrun)
+STAT_LONG_OF(slab, longrun)
+STAT_LONG_OF(stability, longrun)
+STAT_LONG_OF(camera_inside, longrun)
 
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_furnace),      cmocka_unit_test(test_furnace_nee), cmocka_unit_test(test_slab),
         cmocka_unit_test(test_stability),    cmocka_unit_test(test_camera_inside), cmocka_unit_test(long_furnace),
-        cmocka_unit_test(long_furnace_nee),  cmocka_unit_test(long_invariance),
+        cmocka_unit_test(long_furnace_nee),  cmocka_unit_test(long_slab),      cmocka_unit_test(long_stability),
+        cmocka_unit_test(long_camera_inside), cmocka_unit_test(long_invariance),
     };
     return STAT_RUN(tests, argc, argv);
 }
