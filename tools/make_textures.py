@@ -12,6 +12,7 @@ Every texture tiles seamlessly (the noise lattice wraps at the tile size). Only 
 is used (zlib + struct write the PNG) and all randomness is an integer hash of lattice coordinates,
 so every run writes the same bytes.
 """
+import functools
 import math
 import os
 import struct
@@ -21,6 +22,9 @@ import zlib
 SIZES = {"bricks": (256, 256), "planks": (256, 256), "plaster": (128, 128), "wood": (64, 256)}
 
 
+# Cached: the noise asks for the same lattice points over and over (each pixel's octaves read four corners
+# each); a pure function of its integers, so the bytes written do not change. test_gallery runs this twice.
+@functools.lru_cache(maxsize=None)
 def hash01(*ints):
     """A deterministic hash of integers to [0, 1) (a 32-bit integer mixer; no global random state)."""
     h = 0x9E3779B9
