@@ -1,7 +1,8 @@
 /* test_check.c — `murk check` (core/lab/check/check.c) in the default suite.
  *
  *   shipped    `murk check --quick` on every plugin the build made (the .so files in build/plugins: materials,
- *              trackers, transmittance estimators, integrators) passes. Its statistical decisions (the
+ *              trackers, transmittance estimators, integrators) passes, the dielectric's transmission lines
+ *              among them (test_dielectric checks its transmitting fixtures). Its statistical decisions (the
  *              count and false-alarm bound murk check prints) enter this program's sums (stat.h).
  *   broken     transmittance estimators broken on purpose (tests/fixtures/transmittance_flaw.h) fail
  *              where they are broken: tr_denser (a medium 3 % denser: its closed-form T figures, by
@@ -44,6 +45,14 @@ static void test_shipped(void **state)
            rc || failed ? out : strstr(out, "murk check: "));
     assert_int_equal(rc, 0);
     assert_int_equal(failed, 0);
+    /* the dielectric's section covers transmission: the chi-square from inside at 80 degrees (mostly total
+     * internal reflection) and the eta^2-weighted reciprocity across the boundary ran and passed */
+    const char *from = strstr(out, "\ndielectric (material,"), *to = from ? strstr(from, "\ndielectric: all checks passed") : NULL;
+    assert_non_null(to);
+    char *section = strndup(from, (size_t)(to - from));
+    assert_contains(section, "PASS chi2        set 1, wo 80 deg inside");
+    assert_contains(section, "PASS reciprocity set 2                        transmission f(a,b)/eta_a^2 = f(b,a)/eta_b^2");
+    free(section);
     free(out);
     for (int i = 0; i < n; i++)
         free(names[i]);
