@@ -300,7 +300,9 @@ static void test_dense_cell(void **state)
                scale * mt_sigma_t[chroma][2]);
         for (int i = 0; i < NE; i++) {
             est e;
-            run(&s->media[i].m, &ray, 2000, 900 + (uint64_t)i, &e);
+            /* 1000 estimates (stat.h's least for a z-test): the 10 % denser medium is tens of se away even
+             * for ratio tracking, and power_series' collapse to 0 leaves no estimate near T */
+            run(&s->media[i].m, &ray, 1000, 900 + (uint64_t)i, &e);
             char head[64], tail[64];
             snprintf(tail, sizeof tail, "  %.2f us", 1e6 * e.secs / (double)e.a.n);
             snprintf(head, sizeof head, "  %-22s", es[i].label);
