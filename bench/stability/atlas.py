@@ -228,6 +228,7 @@ def run(a):
     res, spp, ref_spp = (12, 16, 64) if a.quick else (a.res, a.spp, 4 * a.spp)
     media = ["cloud"] if a.quick else ["homogeneous", "cloud"]
     t_start = time.time()
+    rendered = set()  # --quick: scenes already rendered (the base case is the chroma and camera sweeps' first point)
     for sweep, values, _ in SWEEPS:
         if a.quick:
             values = [values[0], values[-1]]
@@ -261,9 +262,13 @@ def run(a):
                     ref, ref_var, ref_kind = rs["mean"], rs["var_mean"], "spectral_mis %d spp" % ref_spp
                 for tracker, est in methods:
                     name = tracker + ("+" + est if est else "")
+                    text = scene_yaml(p, medium, tracker, est, res, spp, 1)
+                    if a.quick and text in rendered:
+                        continue
+                    rendered.add(text)
                     path = os.path.join(out, "%s_%s.yaml" % (tag, name))
                     with open(path, "w") as f:
-                        f.write(scene_yaml(p, medium, tracker, est, res, spp, 1))
+                        f.write(text)
                     secs, lookups, x, warn = render(path, os.path.join(out, "%s_%s" % (tag, name)), res, spp)
                     s = stats(x, ref)
                     zi, zb = zscore(s, ref, ref_var, mask) if ref is not None else (0.0, float("nan"))
