@@ -789,69 +789,55 @@ static int ply_header_ends(const char *path)
     free(b);
     return found;
 }
-#endif
 
-/* ---- the block ------------------------------------------------------------------------------------------ */
-
-/* The block's own keys (file, transform, material, emission, interior, exterior) into a. */
-int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, size_t *cap, const char *camera,
-                    murk_asset_camera *cam, char *err, size_t errlen)
+/* The block's keys beside file (transform, lights, light_scale, material, interior, exterior, emission) into a,
+ * *lights and *light_scale. */
+static int read_keys(asset_ctx *a, int *lights, double *light_scale, char *err, size_t errlen)
 {
-    static const char *const keys[] = {"type", "file", "transform", "material", "emission", "interior", "exterior",
-                                       "lights", "light_scale"};
-    if (murk_ycheck_keys(n, "asset", keys, sizeof keys / sizeof keys[0], err, errlen))
-        return -1;
-    const murk_ynode *f = murk_yrequire(n, "file", "asset shape", err, errlen), *c;
-    const char *file = NULL;
-    if (!f || murk_yread_string(f, "asset.file", &file, err, errlen))
-        return -1;
-    static const char *const exts[] = {".gltf", ".glb", ".ply", ".fbx", ".obj"};
-    int known = 0;
-    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
-        known |= ends_with(file, exts[i]);
-    if (!known)
-        return ERR(f, "asset: '%s' is not a file murk reads as an asset (.gltf, .glb, .ply, .fbx, .obj)", file);
-#ifndef MURK_HAVE_ASSIMP
-    (void)s, (void)host, (void)cap, (void)camera, (void)cam, (void)c;
-    return ERR(f, "asset: murk was built without Assimp, so it cannot read %s (install libassimp-dev and rebuild: "
-               "tools/build.sh, or meson configure -Dassimp=enabled)", file);
-#else
-    asset_ctx a = {.s = s, .host = host, .n = n, .file = f, .name = file, .cap = cap};
+    murk_scene *s = a->s;
+    const murk_ynode *n = a->n, *c;
     float m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     const murk_ynode *t = murk_ymap_get(n, "transform");
     if (t && murk_read_transform(t, m, err, errlen))
         return -1;
     for (int i = 0; i < 12; i++)
-        a.user.m[i] = m[i];
-    int lights = 1;
-    double light_scale = 1.0;
-    if ((c = murk_ymap_get(n, "lights")) && murk_yread_bool(c, "asset.lights", &lights, err, errlen))
+        a->user.m[i] = m[i];
+    if ((c = murk_ymap_get(n, "lights")) && murk_yread_bool(c, "asset.lights", lights, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "light_scale")) && murk_yread_range(c, "asset.light_scale", 0, 1e30, &light_scale, err, errlen))
+    if ((c = murk_ymap_get(n, "light_scale")) && murk_yread_range(c, "asset.light_scale", 0, 1e30, light_scale, err, errlen))
         return -1;
     if ((c = murk_ymap_get(n, "material"))) {
         if (c->kind == MURK_Y_SCALAR && !strcmp(c->str, "from_file"))
-            a.from_file = 1;
-        else if (murk_load_lookup_material(s, c, &a.material, err, errlen))
+            a->from_file = 1;
+        else if (murk_load_lookup_material(s, c, &a->material, err, errlen))
             return -1;
     }
-    if ((c = murk_ymap_get(n, "interior")) && murk_load_lookup_medium(s, c, &a.interior, err, errlen))
+    if ((c = murk_ymap_get(n, "interior")) && murk_load_lookup_medium(s, c, &a->interior, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "exterior")) && murk_load_lookup_medium(s, c, &a.exterior, err, errlen))
+    if ((c = murk_ymap_get(n, "exterior")) && murk_load_lookup_medium(s, c, &a->exterior, err, errlen))
         return -1;
     if ((c = murk_ymap_get(n, "emission"))) {
         double e[3];
         if (murk_yread_rgb(c, "emission", 0, 1e30, e, err, errlen))
             return -1;
-        a.emission = murk_rgb3((float)e[0], (float)e[1], (float)e[2]);
-        a.have_emission = 1;
+        a->emission = murk_rgb3((float)e[0], (float)e[1], (float)e[2]);
+        a->have_emission = 1;
     }
-    if (!a.material && !a.from_file && !murk_ymap_get(n, "interior"))
+    if (!a->material && !a->from_file && !murk_ymap_get(n, "interior"))
         return ERR(n, "asset has no material (give one, material: from_file, or interior: MEDIUM for an index-matched "
                    "medium boundary)");
-    if (!a.material && !a.from_file && !murk_rgb_is_black(a.emission))
+    if (!a->material && !a->from_file && !murk_rgb_is_black(a->emission))
         return ERR(murk_ymap_get(n, "emission"), "an emissive asset needs a material");
-    char *path = murk_path_relative_to(s->doc.file, file), ferr[768];
+    return 0;
+}
+
+/* The file at path (a->name as the block gives it) through Assimp into a->ai, a->path = path; first what
+ * Debian's Assimp 5.2 does not survive is refused. On failure path and a->strength are freed. */
+static int import_file(asset_ctx *a, char *path, char *err, size_t errlen)
+{
+    const murk_ynode *f = a->file;
+    const char *file = a->name;
+    char ferr[768];
     uint64_t size;
     FILE *fp = murk_file_open_regular(path, &size, ferr, sizeof ferr);
     if (!fp) {
@@ -859,15 +845,15 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
         return ERR(f, "asset: %s", ferr);
     }
     fclose(fp);
-    if (a.from_file && (ends_with(file, ".gltf") || ends_with(file, ".glb"))) {
+    if (a->from_file && (ends_with(file, ".gltf") || ends_with(file, ".glb"))) {
         unsigned char *bytes = murk_file_read_all(path, &size, ferr, sizeof ferr);
         if (bytes)
-            a.strength = emissive_strengths(bytes, (size_t)size, &a.nstrength);
+            a->strength = emissive_strengths(bytes, (size_t)size, &a->nstrength);
         free(bytes);
     }
     if (ends_with(file, ".ply") && !ply_header_ends(path)) {
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: its PLY header has no 'end_header' line (Assimp 5.2 would read on without end)", file);
     }
     struct aiPropertyStore *props = aiCreatePropertyStore();
@@ -887,19 +873,54 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
     if (bad[0]) {
         aiReleasePropertyStore(props);
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: %s", file, bad);
     }
-    a.ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
-                                                aiProcess_ValidateDataStructure, NULL, props) : NULL;
+    a->ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
+                                                 aiProcess_ValidateDataStructure, NULL, props) : NULL;
     aiReleasePropertyStore(props);
-    a.path = path;
-    if (!a.ai) {
+    a->path = path;
+    if (!a->ai) {
         char msg[512];
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: Assimp cannot read it: %s", file, murk_printable(msg, sizeof msg, aiGetErrorString()));
     }
+    return 0;
+}
+#endif
+
+/* ---- the block ------------------------------------------------------------------------------------------ */
+
+/* An `asset` shape block: its file read through Assimp into shapes, and its lights and camera. */
+int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, size_t *cap, const char *camera,
+                    murk_asset_camera *cam, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"type", "file", "transform", "material", "emission", "interior", "exterior",
+                                       "lights", "light_scale"};
+    if (murk_ycheck_keys(n, "asset", keys, sizeof keys / sizeof keys[0], err, errlen))
+        return -1;
+    const murk_ynode *f = murk_yrequire(n, "file", "asset shape", err, errlen);
+    const char *file = NULL;
+    if (!f || murk_yread_string(f, "asset.file", &file, err, errlen))
+        return -1;
+    static const char *const exts[] = {".gltf", ".glb", ".ply", ".fbx", ".obj"};
+    int known = 0;
+    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
+        known |= ends_with(file, exts[i]);
+    if (!known)
+        return ERR(f, "asset: '%s' is not a file murk reads as an asset (.gltf, .glb, .ply, .fbx, .obj)", file);
+#ifndef MURK_HAVE_ASSIMP
+    (void)s, (void)host, (void)cap, (void)camera, (void)cam;
+    return ERR(f, "asset: murk was built without Assimp, so it cannot read %s (install libassimp-dev and rebuild: "
+               "tools/build.sh, or meson configure -Dassimp=enabled)", file);
+#else
+    asset_ctx a = {.s = s, .host = host, .n = n, .file = f, .name = file, .cap = cap};
+    int lights = 1;
+    double light_scale = 1.0;
+    if (read_keys(&a, &lights, &light_scale, err, errlen) ||
+        import_file(&a, murk_path_relative_to(s->doc.file, file), err, errlen))
+        return -1;
     int rc = 0;
     a.made = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made);
     a.made_emission = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made_emission);
