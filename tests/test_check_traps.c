@@ -10,7 +10,10 @@
  *   heavy     trap_heavy, unbounded weights in `mode: eager` (unbiased): the variance lines fail there
  *             (variance beyond 20x the analog estimator's), never in `mode: bounded`;
  *   estimator trap_tr_roulette, a transmittance estimator that keeps 1 estimate in 50 (x 50): its
- *             variance lines fail, nothing else.
+ *             variance lines fail, nothing else;
+ *   phase     trap_phase_edge, Henyey-Greenstein sampled from the wrong lobe beyond |g| 0.95 only: the
+ *             sweep points g = -0.99 and 0.99 fail their sampled mean cosine, nothing else (the phase
+ *             checks once skipped a range's ends).
  * And the output: a PASS line never shows |z| > 4 (zero-variance figures say they were compared
  * exactly); NaN is named; a missing plugin and a crashing one give a FAIL line with the reason, the
  * summary line and exit 1. All deterministic: murk check's seeds are fixed. */
@@ -125,6 +128,23 @@ static void test_estimator(void **state)
     free(out);
 }
 
+/* A phase function wrong only near |g| = 1: its two sweep points fail, on the mean cosine alone. */
+static void test_phase_edge(void **state)
+{
+    (void)state;
+    char *out = NULL;
+    int rc = check(&out, "trap_phase_edge", NULL);
+    printf("%s", out);
+    assert_int_equal(rc, 1);
+    assert_contains(out, "g: -0.99, its minimum (the others at their defaults)");
+    assert_contains(out, "g: 0.99, its maximum (the others at their defaults)");
+    assert_int_equal(fails_only(out, ", its m", "mean cos"), 2);
+    free(out);
+    rc = check(&out, "trap_phase_edge", "g=0.9");
+    assert_int_equal(rc, 0);
+    free(out);
+}
+
 /* No PASS line shows a z beyond the bound; zero-variance figures say how they were compared. */
 static void test_honest_pass(void **state)
 {
@@ -172,7 +192,7 @@ static void test_honest_fail(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_rate), cmocka_unit_test(test_gain), cmocka_unit_test(test_heavy),
-                                       cmocka_unit_test(test_estimator),
+                                       cmocka_unit_test(test_estimator), cmocka_unit_test(test_phase_edge),
                                        cmocka_unit_test(test_honest_pass), cmocka_unit_test(test_honest_fail)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
