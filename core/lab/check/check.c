@@ -527,6 +527,8 @@ static int param_sets(ck *c, const murk_plugin_desc *d, ck_set *sets)
     printf("  %d parameter set%s: %s\n", n, n == 1 ? "" : "s",
            c->nassign ? "the --set values" : "the defaults, every range at 25 % and 75 %, each parameter at its ends "
                                              "and every enum and bool value");
+    if (err[0])
+        report(c, 2, "parameters  %s", err);
     return n;
 }
 
