@@ -3,15 +3,19 @@ gives the murk command's EXR bit for bit; a scene error raises murk.SceneError w
 line, column; the --set it came from; a dict scene's key path) and the CLI's "did you mean"; input that is
 not a scene or not an image raises a Python exception, never a crash; Ctrl-C (a stop) and a progress
 callback end a render after whole passes; compare gives the CLI's figures; plugins lists the schemas;
-bench returns its rows; and the module imports and renders from a `meson install --destdir` prefix.
+bench returns its rows; a render leaves the GIL to other threads; the sweep example of docs/ runs; and the
+module imports and renders from a `meson install --destdir` prefix.
 Run by meson (tests 'python' and 'python_install'), which sets MURK_SOURCE_ROOT, MURK_EXE, MURK_BUILD_ROOT
 and the module's paths."""
 import copy
+import ctypes
 import json
 import math
 import os
 import subprocess
 import sys
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -164,6 +168,46 @@ def test_ctrl_c_stops_after_whole_passes():
     """ % (SMOKE, SMOKE)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout.strip() == "interrupted True True True", out.stdout + out.stderr
+
+
+def _main_thread_share(work, bin_seconds=0.25):
+    """Runs work() on a thread of its own while this thread counts in which bins of bin_seconds (over
+    work's span) it got to run Python: the share of those bins, and the span in seconds."""
+    t = threading.Thread(target=work)
+    t0 = time.monotonic()
+    t.start()
+    bins = set()
+    while t.is_alive():
+        bins.add(int((time.monotonic() - t0) / bin_seconds))
+    span = time.monotonic() - t0
+    n = max(1, int(span / bin_seconds))
+    return len([b for b in bins if b < n]) / n, span
+
+
+def test_render_releases_the_gil():
+    """Another Python thread runs throughout a render of about 3 s (a bin of 0.25 s without it would mean
+    the render held the GIL for that long). Must fail: the same measure on calls that hold the GIL (libc's
+    usleep through ctypes.PyDLL, three of 1 s) sees this thread stopped in most bins."""
+    r = []
+    share, span = _main_thread_share(lambda: r.append(murk.render(SMOKE, spp=1 << 20, time=3, threads=1,
+                                                                  set={"render.resolution": [32, 32]}, quiet=True)))
+    assert r and r[0].interrupted is False and span > 2.0
+    held = ctypes.PyDLL(None).usleep
+    held_share, _ = _main_thread_share(lambda: [held(1000000) for _ in range(3)])
+    print("main thread ran in %.0f %% of the bins during the render, %.0f %% during GIL-holding calls"
+          % (100 * share, 100 * held_share))
+    assert share >= 0.75, share
+    assert held_share <= 0.5, held_share  # the must-fail case: the measure sees a held GIL
+
+
+def test_sweep_example_runs(tmp_path):
+    """docs/python_sweep.py, the notebook-style example, in its --quick form: it renders, compares and plots."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "sweep.png"
+    run = subprocess.run([sys.executable, os.path.join(SRC, "docs", "python_sweep.py"), "--quick", str(out)], cwd=SRC,
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert out.stat().st_size > 1000 and run.stdout.count("relMSE") == 8
 
 
 def test_compare():
