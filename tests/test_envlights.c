@@ -18,6 +18,8 @@
  *   point_spot         a point light's and a spot's irradiance at points of a plane by light sampling
  *                      (delta: exact) against I cos / r^2 times pbrt-v4's smoothstep, to 1e-5; 1.01 x the
  *                      closed form fails.
+ *   selection_by_power a point, a spot, a delta sun and an envmap in one scene are chosen in the ratios of
+ *                      their powers (the bounding radius cancelled), exactly (1e-5); 1.01 x fails.
  *   furnace            a white diffuse sphere under a constant envmap renders the map's radiance (mean
  *                      over the image within 5 sigma of 1); an albedo-0.99 sphere is rejected (must-fail).
  *   sun_plane          a diffuse plane under a distant light renders albedo / pi E cos theta: exactly for
@@ -328,6 +330,45 @@ static void test_point_spot(void **state)
            nonzero);
     assert_int_equal(bad, 0);
     assert_int_equal(bad_mutant, nonzero);
+}
+
+/* ---- selection by power ------------------------------------------------------------------------------ */
+
+/* A point (I 1), a spot (I 2, cone 40, falloff 20), a delta sun (E 3) and a constant envmap (L 1) in one
+ * scene: their probabilities of being chosen are in the ratios of their powers (lights.h): 4 I, 2 I (1 -
+ * (cos falloff + cos cone) / 2), E R^2 and R^2 x the map's integral over directions (its midpoint sum over
+ * the rows, ~4 pi), R the scene's bounding radius (cancelled in the ratios checked), and sum to 1. To 1e-5;
+ * a 1 % error in any ratio is seen. */
+static void test_selection_by_power(void **state)
+{
+    (void)state;
+    float rgb[3 * MW * MH];
+    char lights[1024];
+    snprintf(lights, sizeof lights,
+             "  - { type: point, position: [0, 2, 0], intensity: 1 }\n"
+             "  - { type: spot, position: [0, 2, 0], direction: [0, -1, 0], intensity: 2, cone_angle: 40, "
+             "falloff_angle: 20 }\n"
+             "  - { type: distant, direction: [0, 1, 0], irradiance: 3 }\n"
+             "  - { type: envmap, file: %s }\n", write_map(MAP_CONSTANT, rgb));
+    murk_scene *s = lights_scene("power.yaml", lights);
+    assert_int_equal(s->nlights, 4);
+    double rows = 0.0;
+    for (int j = 0; j < MH; j++)
+        rows += sin(M_PI * (j + 0.5) / MH);
+    double integral = rows * MW * (2.0 * M_PI / MW) * (M_PI / MH);
+    double spot = 2.0 * 2.0 * (1.0 - 0.5 * (cos(20 * M_PI / 180) + cos(40 * M_PI / 180)));
+    double got[3] = {s->lights[1].pmf / s->lights[0].pmf, s->lights[3].pmf / s->lights[2].pmf,
+                     (double)s->lights[0].pmf + s->lights[1].pmf + s->lights[2].pmf + s->lights[3].pmf};
+    double want[3] = {spot / 4.0, integral / 3.0, 1.0};
+    const char *what[3] = {"spot / point", "envmap / sun", "sum"};
+    for (int k = 0; k < 3; k++) {
+        printf("%-12s %.7f (power ratio %.7f)\n", what[k], got[k], want[k]);
+        assert_true(fabs(got[k] / want[k] - 1.0) < 1e-5);
+        assert_false(fabs(got[k] / (1.01 * want[k]) - 1.0) < 1e-5);
+    }
+    printf("the scene's radius from the point and the sun: R = %.4f\n",
+           sqrt((double)s->lights[2].pmf / s->lights[0].pmf * 4.0 / 3.0));
+    murk_scene_free(s);
 }
 
 /* ---- images ---------------------------------------------------------------------------------------- */
@@ -670,10 +711,11 @@ static void test_bad_input(void **state)
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_envmap_chi2), cmocka_unit_test(test_envmap_pdf), cmocka_unit_test(test_env_mis),
-        cmocka_unit_test(test_point_spot),  cmocka_unit_test(test_furnace),    cmocka_unit_test(test_sun_plane),
-        cmocka_unit_test(test_slab),        cmocka_unit_test(test_equiangular_punctual),
-        cmocka_unit_test(test_legacy),      cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_envmap_chi2),        cmocka_unit_test(test_envmap_pdf), cmocka_unit_test(test_env_mis),
+        cmocka_unit_test(test_point_spot),         cmocka_unit_test(test_selection_by_power),
+        cmocka_unit_test(test_furnace),            cmocka_unit_test(test_sun_plane),
+        cmocka_unit_test(test_slab),               cmocka_unit_test(test_equiangular_punctual),
+        cmocka_unit_test(test_legacy),             cmocka_unit_test(test_bad_input),
     };
     return STAT_RUN(tests, argc, argv);
 }
