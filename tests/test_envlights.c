@@ -21,7 +21,9 @@
  *   selection_by_power a point, a spot, a delta sun and an envmap in one scene are chosen in the ratios of
  *                      their powers (the bounding radius cancelled), exactly (1e-5); 1.01 x fails.
  *   furnace            a white diffuse sphere under a constant envmap renders the map's radiance (mean
- *                      over the image within 5 sigma of 1); an albedo-0.99 sphere is rejected (must-fail).
+ *                      over the image within 5 sigma of 1); an albedo-0.99 sphere is rejected (must-fail);
+ *                      so does a map of half that radiance beside a constant `background` of the other
+ *                      half (the background then sampled as a part of the environment); 1.01 x fails.
  *   sun_plane          a diffuse plane under a distant light renders albedo / pi E cos theta: exactly for
  *                      a delta sun, within 5 sigma for a 40-degree cone above the horizon and for one that
  *                      the horizon cuts (the closed form integrated numerically); 1.01 x fails (must-fail).
@@ -418,22 +420,25 @@ static void test_furnace(void **state)
     float rgb[3 * MW * MH];
     char text[1024];
     const char *map = write_map(MAP_CONSTANT, rgb);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) { /* 2: half the radiance from the map, half from a constant background */
         snprintf(text, sizeof text,
-                 "murk: 1\nrender: { resolution: [32, 32], spp: 64, seed: 1 }\n"
+                 "murk: 1\nrender: { resolution: [32, 32], spp: 64, seed: 1 }\n%s"
                  "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 25 }\n"
                  "integrator: { type: volpath_nee }\nmaterials: { w: { type: diffuse, albedo: %s } }\n"
-                 "lights: [ { type: envmap, file: %s } ]\n"
+                 "lights: [ { type: envmap, file: %s, scale: %s } ]\n"
                  "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, material: w } ]\n",
-                 k ? "0.99" : "1", map);
+                 k == 2 ? "background: 0.5\n" : "", k == 1 ? "0.99" : "1", map, k == 2 ? "0.5" : "1");
         double m, se;
         render_mean("furnace.yaml", text, NULL, &m, &se);
         double z = (m - 1.0) / se;
-        printf("white furnace, albedo %s: %.6f +- %.6f (z %+.2f against 1)\n", k ? "0.99" : "1", m, se, z);
+        printf("white furnace, albedo %s%s: %.6f +- %.6f (z %+.2f against 1)\n", k == 1 ? "0.99" : "1",
+               k == 2 ? ", map 0.5 + background 0.5" : "", m, se, z);
         if (k == 0)
             assert_true(stat_z_ok(m, se, 1.0, 0.0));
-        else /* the 1 %-darker sphere is seen */
+        else if (k == 1) /* the 1 %-darker sphere is seen */
             assert_true(stat_must_fail("white furnace with albedo 0.99", fabs(z) > STAT_Z, z));
+        else /* the constant background sampled as one more part of the environment */
+            check_closed_form("furnace, map 0.5 + background 0.5", m, se, 1.0, 0.0);
     }
 }
 
