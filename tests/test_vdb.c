@@ -514,6 +514,23 @@ static void test_vdb_grids(void **state)
     fclose(out);
     murk_field_free(load_vdb(one, "density")); /* the file as written loads */
     expect_vdb_error(kids, "density", "truncated: grid 'density' root children at byte");
+    /* the grid's delayed-load metadata claiming 2^32 - 1 leaves: libopenvdb sizes its arrays by the claim
+     * (4 GB; 36 GB for the compressed sizes) before it reads them */
+    const char *dl = tmp_path("delayed_load.vdb");
+    in = fopen(one, "rb"), out = fopen(dl, "wb");
+    assert_true(in && out);
+    n = fread(whole, 1, sizeof whole, in);
+    static const char tag[] = "__delayedload";
+    char *at_tag = NULL;
+    for (size_t i = 0; !at_tag && i + sizeof tag <= n; i++)
+        if (memcmp(whole + i, tag, sizeof tag - 1) == 0)
+            at_tag = whole + i;
+    assert_non_null(at_tag);
+    memset(at_tag + sizeof tag - 1 + 4, 0xff, 4); /* after the type name, the value's byte count, then the count */
+    assert_true(fwrite(whole, 1, n, out) == n);
+    fclose(in);
+    fclose(out);
+    expect_vdb_error(dl, "density", "file_delayed_load claims 4294967295 leaves");
     murk_rng rng;
     murk_rng_seed(&rng, 3, 4, 5);
     for (size_t i = 0; i < sizeof buf; i++)
