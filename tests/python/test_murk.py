@@ -260,6 +260,14 @@ def test_bench_rows(tmp_path):
         murk.bench(SMOKE, vary={"media.smok.type": ["delta"]}, spp=[1], repeat=2, ref_spp=4)
 
 
+def test_bench_frame(tmp_path):
+    """frame=True: the same rows as a pandas DataFrame (skipped where python3-pandas is not installed)."""
+    pandas = pytest.importorskip("pandas")
+    df = murk.bench(CORNELL, vary={"integrator.max_depth": [2, 4]}, set={"render.resolution": [8, 8]}, spp=[1],
+                    repeat=2, ref_spp=4, threads=1, frame=True)
+    assert isinstance(df, pandas.DataFrame) and len(df) == 4 and set(df["label"]) == {"max_depth=2", "max_depth=4"}
+
+
 @pytest.mark.install
 def test_installed_prefix(tmp_path):
     """meson install --destdir, then the installed module alone (no build-tree paths) renders."""
