@@ -694,6 +694,10 @@ static void test_bad_input(void **state)
     check_refused("type.yaml", "  - { type: spto, position: [0, 2, 0] }\n",
                   "type.yaml:4:13: lights[0]: unknown light type 'spto' (did you mean 'spot'?)");
     check_refused("key.yaml", "  - { type: point, position: [0, 2, 0], intensty: 1 }\n", "(did you mean 'intensity'?)");
+    check_refused("sun_dir.yaml", "  - { type: sky, sun_direction: [0, 0, 0] }\n",
+                  "sun_dir.yaml:4:33: lights[0] (sky): sun_direction has no length");
+    check_refused("sun_bool.yaml", "  - { type: sky, sun_direction: [0, 1, 0], sun: maybe }\n",
+                  "sun_bool.yaml:4:49: lights[0] (sky): sun must be true or false");
     check_refused("turbidity.yaml", "  - { type: sky, sun_direction: [0, 1, 0], turbidity: 20 }\n",
                   "turbidity.yaml:4:55: lights[0] (sky): turbidity must be in [1.7, 10]");
     /* a sun below the horizon is allowed: a warning, a black sky, no sun */
