@@ -9,7 +9,8 @@ that expands to one; an initialised table is not one), and counts its lines from
 head to its closing brace. Comments, strings and preprocessor lines are blanked first, so a brace in
 them does not count. Fails (exit 1) naming each function longer than the limit; --list K also prints
 the K longest. --self-test first shows the count on small files made for it: a function of exactly the
-limit passes, one line more fails, braces in comments and strings and a table do not count."""
+limit passes, one line more fails (inside a C++ namespace too), braces in comments and strings and a
+table do not count."""
 import os
 import re
 import sys
@@ -51,12 +52,19 @@ def blank(src):
 def functions(path):
     """[(lines, first line, name)] of the functions in the file at path."""
     s = blank(open(path, encoding='utf-8', errors='replace').read())
-    out, depth, head_start, head = [], 0, 0, ''
+    out, depth, head_start, head, opened = [], 0, 0, '', 0
     for i, c in enumerate(s):
         if c == '{':
             if depth == 0:
                 head = s[head_start:i]
+                if re.search(r'(\bnamespace\b[\w\s:]*|\bextern\s*"\s*")$', head.strip()):
+                    opened += 1  # a C++ namespace or extern "C" block: its functions count as top-level
+                    head_start = i + 1
+                    continue
             depth += 1
+        elif c == '}' and depth == 0 and opened:
+            opened -= 1
+            head_start = i + 1
         elif c == '}' and depth > 0:
             depth -= 1
             if depth == 0:
@@ -89,6 +97,7 @@ def self_test(limit):
     cases = {  # name: (source, the longest function's length, or 0 for none)
         'at the limit': (f'int f(int x)\n{{\n{body(limit - 3)}}}\n', limit),
         'one over': (f'static int g(int x) {{\n{body(limit - 1)}}}\n', limit + 1),
+        'inside a C++ namespace': (f'namespace {{\nint n(int x)\n{{\n{body(limit - 2)}}}\n}} // namespace\n', limit + 1),
         'braces in comments and strings': ('int h(void)\n{\n    /* { */ const char *s = "}{";\n    // }\n'
                                            "    return s[0] == '{';\n}\n", 6),
         'a table is no function': ('static const int t[] = {\n' + '    1,\n' * (limit + 5) + '};\n', 0),
