@@ -5,7 +5,8 @@
 
 Reads every .c, .h and .cpp file below SOURCE_ROOT/core and SOURCE_ROOT/plugins, finds each top-level
 brace block whose head holds a parenthesis and no `=` before it (a function definition, or a macro
-that expands to one; an initialised table is not one), and counts its lines from the first line of its
+that expands to one; an initialised table is not one; the blocks of a C++ namespace or extern "C" are
+looked into, a C++ struct's or class's methods are not), and counts its lines from the first line of its
 head to its closing brace. Comments, strings and preprocessor lines are blanked first, so a brace in
 them does not count. Fails (exit 1) naming each function longer than the limit; --list K also prints
 the K longest. --self-test first shows the count on small files made for it: a function of exactly the
@@ -69,7 +70,7 @@ def functions(path):
             depth -= 1
             if depth == 0:
                 h = head.strip()
-                if '(' in h and '=' not in h.split('(')[0] and not re.search(r'\b(struct|enum|union)\b[^(]*$', h):
+                if '(' in h and '=' not in h.split('(')[0] and not re.search(r'\b(struct|enum|union|class)\s*\w*\s*$', h):
                     first = s.count('\n', 0, head_start + len(head) - len(head.lstrip())) + 1
                     last = s.count('\n', 0, i) + 1
                     names = re.findall(r'(\w+)\s*\(', h)
@@ -98,6 +99,7 @@ def self_test(limit):
         'at the limit': (f'int f(int x)\n{{\n{body(limit - 3)}}}\n', limit),
         'one over': (f'static int g(int x) {{\n{body(limit - 1)}}}\n', limit + 1),
         'inside a C++ namespace': (f'namespace {{\nint n(int x)\n{{\n{body(limit - 2)}}}\n}} // namespace\n', limit + 1),
+        'an enum parameter': (f'static int e(int x, enum kind k)\n{{\n{body(limit - 2)}}}\n', limit + 1),
         'braces in comments and strings': ('int h(void)\n{\n    /* { */ const char *s = "}{";\n    // }\n'
                                            "    return s[0] == '{';\n}\n", 6),
         'a table is no function': ('static const int t[] = {\n' + '    1,\n' * (limit + 5) + '};\n', 0),
