@@ -966,7 +966,11 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
     /* read first without post-processing, to refuse a face without vertices (a PLY face list of 0), on which
      * Debian's Assimp 5.2 aborts in its Triangulate step (an ai_assert; found by tests/fuzz, seed ply_empty_face);
      * then read again with the steps. Not aiApplyPostProcessing on the first scene: when its validation fails
-     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release). */
+     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release), as it does when
+     * any later step fails (SortByPType removing every mesh of a file of points or lines); and validating in the
+     * first read would run before Assimp's preprocessing sets the primitive types it checks faces by, and
+     * report a file's other faults before its empty face. So the second read stays; what it costs (the first
+     * two imports of a process are the slow ones) is in docs/results.md, "Assets read twice". */
     io_ctx ioc = {s, path};
     struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)&ioc};
     const struct aiScene *probe = aiImportFileExWithProperties(path, 0, &io, props);
