@@ -16,8 +16,9 @@
  *                      twice or outside the box, a box too large) each say what and where.
  *   vdb grids          float, half and double grids, values at voxel centres; the grid name missing (the error
  *                      lists the file's grids), unnamed in a file of two, vec3s / int32 / level set / frustum /
- *                      no active voxels / truncated / random bytes / a metadata count over the file's size: each
- *                      a "path: ..." error.
+ *                      no active voxels / truncated / random bytes / a metadata count over the file's size /
+ *                      a root claiming 600 children where the file holds one (the walk of the topology):
+ *                      each a "path: ..." error.
  *   closed form        a constant grid of two active 128^3 tiles with an empty tile between them: every
  *                      unbiased transmittance estimator against exp(-sigma_t c n h) within 4 se (the figure
  *                      resolves a 3 % error), and the field's quadrature against the closed form.
@@ -623,6 +624,47 @@ static void test_vdb_grids(void **state)
     fclose(in);
     fclose(out);
     expect_vdb_error(claims, "density", "truncated: the file's metadata (2147483647 entries) at byte 61");
+    /* a root that claims 600 children where the file holds one (uncompressed, so libopenvdb's reads past the
+     * end fail silently): libopenvdb would build a 264 KB node for each from its failed stream, 158 MB from a
+     * file of a few KB (the fuzz harness's out-of-memory); the walk of the topology refuses it. The root's
+     * counts follow the buffer count 1 and the background 0: tiles 0, children 1, the child at (0, 0, 0). */
+    const char *one = vdb_file("one_child.vdb", "grid density float\ncompress none\nvoxel 1 2 3 0.5\n");
+    const char *kids = tmp_path("children.vdb");
+    in = fopen(one, "rb"), out = fopen(kids, "wb");
+    assert_true(in && out);
+    static char whole[65536];
+    n = fread(whole, 1, sizeof whole, in);
+    assert_true(n > 0 && n < sizeof whole);
+    static const unsigned char root[28] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1}; /* ... and the origin */
+    size_t at = 0, found = 0;
+    for (size_t i = 0; i + sizeof root <= n; i++)
+        if (memcmp(whole + i, root, sizeof root) == 0)
+            at = i, found++;
+    assert_int_equal(found, 1);
+    const unsigned char six_hundred[4] = {600 & 0xff, 600 >> 8, 0, 0};
+    memcpy(whole + at + 12, six_hundred, 4);
+    assert_true(fwrite(whole, 1, n, out) == n);
+    fclose(in);
+    fclose(out);
+    murk_field_free(load_vdb(one, "density")); /* the file as written loads */
+    expect_vdb_error(kids, "density", "truncated: grid 'density' root children at byte");
+    /* the grid's delayed-load metadata claiming 2^32 - 1 leaves: libopenvdb sizes its arrays by the claim
+     * (4 GB; 36 GB for the compressed sizes) before it reads them */
+    const char *dl = tmp_path("delayed_load.vdb");
+    in = fopen(one, "rb"), out = fopen(dl, "wb");
+    assert_true(in && out);
+    n = fread(whole, 1, sizeof whole, in);
+    static const char tag[] = "__delayedload";
+    char *at_tag = NULL;
+    for (size_t i = 0; !at_tag && i + sizeof tag <= n; i++)
+        if (memcmp(whole + i, tag, sizeof tag - 1) == 0)
+            at_tag = whole + i;
+    assert_non_null(at_tag);
+    memset(at_tag + sizeof tag - 1 + 4, 0xff, 4); /* after the type name, the value's byte count, then the count */
+    assert_true(fwrite(whole, 1, n, out) == n);
+    fclose(in);
+    fclose(out);
+    expect_vdb_error(dl, "density", "file_delayed_load claims 4294967295 leaves");
     murk_rng rng;
     murk_rng_seed(&rng, 3, 4, 5);
     for (size_t i = 0; i < sizeof buf; i++)

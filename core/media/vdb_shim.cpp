@@ -15,10 +15,13 @@
 #include <openvdb/Grid.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
+#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
+#include <array>
 #include <fstream>
+#include <map>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -108,7 +111,14 @@ std::string grid_names(openvdb::io::File &file)
  * stream (a hang the fuzz harness found). So the parts that carry such claims are walked here first, each
  * against the bytes that remain: the header, the file's metadata, every grid descriptor (its offsets in
  * order inside the file), each grid's metadata and transform, and a float or double grid's root counts.
- * What lies inside the nodes (masks, values, compressed blocks) is of fixed size or checked by libopenvdb. */
+ * A float or double grid's tree is walked whole, as libopenvdb 10 reads it (Tree::readTopology, then
+ * readBuffers): every node a child mask announces must be in the file, every value block's length must be
+ * the one its node needs, a root child may appear once and at a node's origin, and each zip block of the
+ * topology must inflate to its length. libopenvdb checks none of these before it allocates: a count past
+ * the end of the file made it build a node per claim from a failed stream (1.4 GB from 18 KB, found by
+ * fuzz_vdb), a raw block longer than its node overran the node's buffer, and a node that failed to read
+ * was lost with its subtree (a leak). What this walk leaves to libopenvdb is only the content of the leaf
+ * buffers' compressed blocks, whose failure it reports with the tree already owning the leaf. */
 class Framing {
 public:
     explicit Framing(const char *path) : in(path, std::ios::binary)
@@ -116,7 +126,7 @@ public:
         if (!in)
             throw Failure{"cannot open it"};
         in.seekg(0, std::ios::end);
-        size = static_cast<uint64_t>(in.tellg());
+        size = file_size = static_cast<uint64_t>(in.tellg());
         in.seekg(0);
     }
     void check()
@@ -139,7 +149,7 @@ public:
 
 private:
     std::ifstream in;
-    uint64_t size = 0, pos = 0;
+    uint64_t size = 0, pos = 0, file_size = 0; /* size: the end of the part being walked */
     uint32_t version = 0;
 
     void need(uint64_t n, const std::string &what)
@@ -148,9 +158,9 @@ private:
             throw Failure{"truncated: " + what + " at byte " + std::to_string(pos) + " claims " + std::to_string(n) +
                           " bytes, " + std::to_string(size - pos) + " remain"};
     }
-    void read(void *p, uint64_t n)
+    void read(void *p, uint64_t n, const std::string &what = "a field")
     {
-        need(n, "a field");
+        need(n, what);
         in.read(static_cast<char *>(p), static_cast<std::streamsize>(n));
         pos += n;
     }
@@ -194,8 +204,54 @@ private:
                 if (type == f.type && bytes != f.bytes)
                     throw Failure{what + ": '" + printable(name) + "' is a " + type + " of " + std::to_string(bytes) +
                                   " bytes; a " + type + " has " + std::to_string(f.bytes)};
-            skip(bytes, what + ": a value");
+            if (type == "__delayedload" && bytes > 0)
+                delayed_load(what, bytes);
+            else
+                skip(bytes, what + ": a value");
         }
+    }
+    /* io::DelayedLoadMetadata::readValue, which sizes its arrays by the count it reads and the size a blosc
+     * header claims (found by fuzz_vdb: a 4 GB allocation): a leaf count no larger than the file could hold
+     * (a leaf takes at least its 64-byte mask), then a mask of a byte per leaf and the leaves' compressed
+     * sizes (8 bytes each; a length of 2^32 - 1 for none), each raw after a length 0 or a blosc block whose
+     * header states that length uncompressed and its own length compressed; all of it inside the value's
+     * byte count, since libopenvdb reads on from where the value ends for it, not where the count says. */
+    void delayed_load(const std::string &what, uint32_t bytes)
+    {
+        const std::string where = what + ": file_delayed_load";
+        need(bytes, where);
+        uint64_t limit = size, stop = pos + bytes;
+        size = stop;
+        uint64_t count = u32();
+        if (count > file_size / 64)
+            throw Failure{where + " claims " + std::to_string(count) + " leaves; the file holds at most " +
+                          std::to_string(file_size / 64)};
+        for (uint64_t elem : {1u, 8u}) {
+            uint32_t len = u32();
+            if (elem == 8 && len == UINT32_MAX)
+                break;
+            if (len == 0) {
+                skip(count * elem, where);
+                continue;
+            }
+            unsigned char h[16];
+            if (len < sizeof h)
+                throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes, shorter than its header"};
+            read(h, sizeof h, where);
+            uint32_t plain = le32(h + 4), packed = le32(h + 12);
+            if (plain != count * elem || packed != len)
+                throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes whose header says " +
+                              std::to_string(packed) + " bytes, " + std::to_string(plain) + " uncompressed, where " +
+                              std::to_string(count * elem) + " are needed"};
+            skip(len - sizeof h, where);
+        }
+        size = limit;
+        seek(stop);
+    }
+    static uint32_t le32(const unsigned char *b)
+    {
+        return static_cast<uint32_t>(b[0]) | static_cast<uint32_t>(b[1]) << 8 | static_cast<uint32_t>(b[2]) << 16 |
+               static_cast<uint32_t>(b[3]) << 24;
     }
     /* A grid descriptor and the head of its grid: metadata, transform, root counts. */
     void descriptor(uint32_t g)
@@ -211,18 +267,129 @@ private:
         uint64_t limit = size;
         size = block; /* the head lies before the grid's buffers */
         seek(grid);
-        skip(4, "a grid's compression"); /* compression flags */
+        uint32_t compression = u32(); /* Archive::readGridCompression */
         meta_map("grid '" + name + "' metadata");
         transform(name);
         int vsize = type.rfind("Tree_float_5_4_3", 0) == 0 ? 4 : type.rfind("Tree_double_5_4_3", 0) == 0 ? 8 : 0;
-        if (vsize && !instance) { /* Tree::readTopology's buffer count, then the root: background, tiles, children */
-            skip(4 + static_cast<uint64_t>(vsize), "a grid's root");
-            uint64_t tiles = u32(), children = u32();
-            need(tiles * (13 + static_cast<uint64_t>(vsize)) + children * 12, "grid '" + name + "' root (" +
-                 std::to_string(tiles) + " tiles, " + std::to_string(children) + " children)");
+        if (vsize && !instance) {
+            static const std::string half = "_HalfFloat";
+            bool is_half = type.size() > half.size() && type.compare(type.size() - half.size(), half.size(), half) == 0;
+            tree(Tree{name, static_cast<uint64_t>(vsize), is_half ? 2u : static_cast<uint64_t>(vsize), compression},
+                 block, end);
         }
         size = limit;
         seek(next);
+    }
+
+    /* One grid's tree as the walk sees it: its value size in memory and in the file, its compression flags. */
+    struct Tree {
+        std::string name;
+        uint64_t vsize, fsize;
+        uint32_t compression;
+    };
+    enum { ZIP = 0x1, ACTIVE_MASK = 0x2, BLOSC = 0x4 }; /* io::COMPRESS_* */
+
+    static uint64_t popcount(const uint64_t *w, uint64_t words)
+    {
+        uint64_t n = 0;
+        for (uint64_t i = 0; i < words; i++)
+            n += static_cast<uint64_t>(__builtin_popcountll(w[i]));
+        return n;
+    }
+    /* Tree::readTopology (a buffer count, the root's background, tiles and children, each child's subtree),
+     * then Tree::readBuffers: each leaf's values, in the order libopenvdb reads them (root children by
+     * origin, as its std::map holds them; inside a node by index). */
+    void tree(const Tree &t, uint64_t block, uint64_t end)
+    {
+        const std::string root = "grid '" + t.name + "' root";
+        skip(4 + t.vsize, root);
+        uint64_t tiles = u32(), children = u32();
+        need(tiles * (13 + t.vsize) + children * 12, root + " (" + std::to_string(tiles) + " tiles, " +
+             std::to_string(children) + " children)");
+        skip(tiles * (13 + t.vsize), root + " tiles");
+        std::map<std::array<int32_t, 3>, std::vector<uint16_t>> kids; /* each root child's leaves' active counts */
+        for (uint64_t c = 0; c < children; c++) {
+            std::array<int32_t, 3> o;
+            read(o.data(), 12, root + " children");
+            if ((o[0] | o[1] | o[2]) & 4095)
+                throw Failure{root + ": a child at (" + std::to_string(o[0]) + ", " + std::to_string(o[1]) + ", " +
+                              std::to_string(o[2]) + "), not at a multiple of 4096"};
+            auto slot = kids.emplace(o, std::vector<uint16_t>());
+            if (!slot.second)
+                throw Failure{root + ": two children at (" + std::to_string(o[0]) + ", " + std::to_string(o[1]) +
+                              ", " + std::to_string(o[2]) + ")"};
+            internal(t, 5, slot.first->second);
+        }
+        if (pos != block)
+            throw Failure{"grid '" + t.name + "': its topology ends at byte " + std::to_string(pos) +
+                          ", its buffers are said to begin at " + std::to_string(block)};
+        size = end; /* the buffers lie before the grid's end */
+        for (const auto &k : kids)
+            for (uint16_t on : k.second) {
+                skip(64, "grid '" + t.name + "' a leaf's value mask");
+                values(t, 512, on, 64, false);
+            }
+    }
+    /* InternalNode::readTopology: child and value masks, the node's values, then each child in index order
+     * (log2 5: the root's children, log2 4: theirs; a leaf's topology is its value mask). */
+    void internal(const Tree &t, int log2, std::vector<uint16_t> &leaves)
+    {
+        const uint64_t n = 1ull << (3 * log2), words = n / 64;
+        std::vector<uint64_t> child(words), value(words);
+        const std::string masks = "grid '" + t.name + "' a node's masks";
+        read(child.data(), n / 8, masks);
+        read(value.data(), n / 8, masks);
+        values(t, n, popcount(value.data(), words), n / 8, true);
+        for (uint64_t w = 0; w < words; w++)
+            for (uint64_t bits = child[w]; bits; bits &= bits - 1) {
+                if (log2 == 5) {
+                    internal(t, 4, leaves);
+                } else {
+                    uint64_t mask[8];
+                    read(mask, 64, "grid '" + t.name + "' a leaf's value mask");
+                    leaves.push_back(static_cast<uint16_t>(popcount(mask, 8)));
+                }
+            }
+    }
+    /* io::readCompressedValues for a node of n values, `on` of them active, whose masks have mask_bytes:
+     * a flag, up to two inactive values, a selection mask, then the values (only the active ones under mask
+     * compression), raw or in a zip or blosc block with its signed length first. inflate: check that a zip
+     * block inflates to its length (a topology block: libopenvdb loses the node when it does not). */
+    void values(const Tree &t, uint64_t n, uint64_t on, uint64_t mask_bytes, bool inflate)
+    {
+        const std::string what = "grid '" + t.name + "' values";
+        int8_t flag = static_cast<int8_t>(u8());
+        if (flag == 2 || flag == 4 || flag == 5)
+            skip(t.vsize * (flag == 5 ? 2 : 1), what);
+        if (flag == 3 || flag == 4 || flag == 5)
+            skip(mask_bytes, what);
+        uint64_t count = (t.compression & ACTIVE_MASK) && flag != 6 ? on : n;
+        if (t.fsize != t.vsize && count == 0)
+            return; /* io::HalfReader reads nothing for no values */
+        uint64_t bytes = count * t.fsize;
+        if (!(t.compression & (ZIP | BLOSC))) {
+            skip(bytes, what);
+            return;
+        }
+        int64_t len = static_cast<int64_t>(u64());
+        if (len <= 0) {
+            if (len == INT64_MIN || static_cast<uint64_t>(-len) != bytes)
+                throw Failure{what + ": a block of " + std::to_string(len) + " bytes where " +
+                              std::to_string(bytes) + " are stored uncompressed"};
+            skip(bytes, what);
+            return;
+        }
+        need(static_cast<uint64_t>(len), what + " (a compressed block)");
+        if (inflate && !(t.compression & BLOSC)) {
+            std::vector<Bytef> in(static_cast<size_t>(len)), out(bytes ? bytes : 1);
+            read(in.data(), static_cast<uint64_t>(len));
+            uLongf got = static_cast<uLongf>(bytes);
+            if (uncompress(out.data(), &got, in.data(), static_cast<uLong>(len)) != Z_OK || got != bytes)
+                throw Failure{what + ": a zip block at byte " + std::to_string(pos - static_cast<uint64_t>(len)) +
+                              " does not inflate to " + std::to_string(bytes) + " bytes"};
+            return;
+        }
+        skip(static_cast<uint64_t>(len), what);
     }
     /* Transform::read: a map type name, then the map (its size by type; a frustum is refused later). */
     void transform(const std::string &name)

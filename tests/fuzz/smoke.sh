@@ -1,9 +1,10 @@
 #!/bin/sh
 # smoke.sh HARNESS CORPUS MAX_LEN — the fuzz smoke step for one libFuzzer harness: replays every input of
 # the committed seed corpus, then fuzzes fresh mutations for MURK_FUZZ_SECONDS (default 10) seconds,
-# from the fixed random seed MURK_FUZZ_SEED (default 1; 0: libFuzzer picks one): CI tries the same inputs
-# on every run (a slower machine a prefix of them), so a failure there comes from a change, not from a new
-# seed reaching a known bug of a library's (longer runs by hand look for those). Each input is limited to
+# from the fixed random seed MURK_FUZZ_SEED (default 1; 0: libFuzzer picks one) and without reloading the
+# corpus folders: the mutations follow one sequence, and a slower machine runs a prefix of it (a time limit
+# makes that prefix vary, so this narrows, not removes, the chance that a run reaches a known bug of a
+# library's before a change does; longer runs by hand look for those). Each input is limited to
 # 10 s (a slower one is a hang) and 2 GB. New inputs go to a scratch folder, never into the committed corpus.
 # Prints one line of figures; fails on any crash, leak, hang or OOM (the reproducer is kept and named).
 set -u
@@ -26,7 +27,7 @@ if [ $rc -ne 0 ]; then
 fi
 # 2. fresh mutations for a bounded time (fork-free, one job)
 mkdir "$work/new"
-"$h" -seed="${MURK_FUZZ_SEED:-1}" -max_total_time="$secs" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+"$h" -seed="${MURK_FUZZ_SEED:-1}" -reload=0 -max_total_time="$secs" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
      -artifact_prefix="$work/" "$work/new" "$corpus" >"$log" 2>&1
 rc=$?
 execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
