@@ -10,7 +10,9 @@
  * stated overhead (the nodes and the top table, which are not per brick).
  *
  * Lookups: one field held both ways (the same voxels; the sparse box is the active box grown by a voxel of
- * zeros, so values agree to float rounding, checked on the sums): cornell_smoke's cloud baked at
+ * zeros, so values agree to float rounding, checked on the sums), the sparse side built as murk builds a .vdb
+ * and held in the form sparse.c's rule gives it (for a grid it holds dense, the forced sparse form is timed
+ * too): cornell_smoke's cloud baked at
  * 256^3 (64 MiB dense; its voxels that are 0 are inactive in the sparse copy, 62 % of the box), and a 128^3
  * checker of 0.2 / 1.4 with every voxel active (no empty brick: the sparse cost of a full grid). Two point
  * sets, in the box inset by a voxel (where both hold the same field): 2 000 000 uniform points (every lookup a cache miss for the dense grid as for the sparse
@@ -102,6 +104,10 @@ static void memory_figure(void)
     }
     murk_field_info fi;
     murk_field_describe(f, &fi);
+    if (!fi.sparse) {
+        fprintf(stderr, "the 3 %% ball is held dense: sparse.c's rule has changed\n");
+        exit(1);
+    }
     const murk_sparse *s = f->sparse;
     double floats = 4.0 * (double)fi.active, nodes = (double)s->nnodes * sizeof(murk_sparse_node);
     double top = (double)s->nt[0] * s->nt[1] * s->nt[2] * sizeof *s->top;
@@ -119,8 +125,9 @@ static void memory_figure(void)
 
 /* ---- lookups ----------------------------------------------------------------------------------------- */
 
-/* The sparse copy of a dense grid: its non-zero voxels active, in leaves of the box's index space. */
-static murk_field *sparse_copy(const murk_field *d)
+/* The sparse copy of a dense grid: its non-zero voxels active, in leaves of the box's index space, held as
+ * `hold` says (MURK_HOLD_SMALLER: as murk holds a .vdb of it). */
+static murk_field *sparse_copy(const murk_field *d, int hold)
 {
     char err[1024];
     int amin[3] = {0, 0, 0}, amax[3] = {d->res[0] - 1, d->res[1] - 1, d->res[2] - 1};
@@ -163,7 +170,7 @@ static murk_field *sparse_copy(const murk_field *d)
         map[5 * a] = h;
         map[4 * a + 3] = murk_v3_get(d->lo, a) + 0.5 * h;
     }
-    murk_field *s = b ? murk_sparse_end(b, map, err, sizeof err) : NULL;
+    murk_field *s = b ? murk_sparse_finish(b, map, hold, err, sizeof err) : NULL;
     if (!s) {
         fprintf(stderr, "%s\n", err);
         exit(1);
@@ -208,7 +215,7 @@ static void time_lookups(const char *label, const murk_field *d, const murk_fiel
         ts += t[1];
     }
     qsort(ratio, (size_t)rounds, sizeof *ratio, cmp_double);
-    printf("  %-34s dense %6.1f ns, sparse %6.1f ns per lookup; sparse / dense median %.3f (min %.3f, max %.3f, %d "
+    printf("  %-34s dense %6.1f ns, as .vdb %6.1f ns per lookup; .vdb / dense median %.3f (min %.3f, max %.3f, %d "
            "rounds)\n", label, 1e9 * td / ((double)n * rounds), 1e9 * ts / ((double)n * rounds), ratio[rounds / 2],
            ratio[0], ratio[rounds - 1], rounds);
     free(ratio);
@@ -224,6 +231,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: sparse_grid [rounds] [lookups per round and side]\n");
         return 2;
     }
+    double load[3];
+    if (getloadavg(load, 3) == 3) /* the machine's load, beside the figures it disturbs */
+        printf("load average at the start %.2f %.2f %.2f\n", load[0], load[1], load[2]);
     memory_figure();
     murk_vec3 *uni = malloc((size_t)n * sizeof *uni), *ray = malloc((size_t)n * sizeof *ray);
     murk_field *fields[2];
@@ -238,12 +248,20 @@ int main(int argc, char **argv)
     free(cv);
     static const char *const names[2] = {"cloud 256^3", "checker 128^3 (all active)"};
     for (int fi = 0; fi < 2; fi++) {
-        murk_field *d = fields[fi], *s = sparse_copy(d);
-        murk_field_info di, si;
+        murk_field *d = fields[fi], *s = sparse_copy(d, MURK_HOLD_SMALLER), *forced = NULL;
+        murk_field_info di, si, fo;
         murk_field_describe(d, &di);
         murk_field_describe(s, &si);
-        printf("lookups, %s: dense %.1f MiB, sparse %.1f MiB (%llu active voxels)\n", names[fi],
-               (double)di.bytes / 1048576.0, (double)si.bytes / 1048576.0, (unsigned long long)si.active);
+        printf("lookups, %s: dense %.1f MiB; as .vdb, held %s (sparse.c's rule): %.1f MiB, its sparse form %.3f MiB "
+               "(%zu bytes; dense form %llu bytes) (%llu active voxels)\n", names[fi], (double)di.bytes / 1048576.0,
+               si.sparse ? "sparse" : "dense", (double)si.bytes / 1048576.0, (double)si.sparse_bytes / 1048576.0,
+               si.sparse_bytes, 4ull * (unsigned long long)s->res[0] * (unsigned long long)s->res[1] *
+               (unsigned long long)s->res[2], (unsigned long long)si.active);
+        if (!si.sparse) { /* held dense: the sparse form's cost, for the record */
+            forced = sparse_copy(d, MURK_HOLD_SPARSE);
+            murk_field_describe(forced, &fo);
+            printf("  and held sparse (forced): %.1f MiB\n", (double)fo.bytes / 1048576.0);
+        }
         murk_rng rng;
         murk_rng_seed(&rng, 42, (uint64_t)fi, 0);
         /* the box inset by one voxel: in the border half-cells the dense grid clamps while the sparse one falls to
@@ -267,10 +285,17 @@ int main(int argc, char **argv)
         }
         time_lookups("uniform points", d, s, uni, n, rounds);
         time_lookups("along rays, quarter-voxel steps", d, s, ray, n, rounds);
+        if (forced) {
+            time_lookups("uniform points, forced sparse", d, forced, uni, n, rounds);
+            time_lookups("along rays, forced sparse", d, forced, ray, n, rounds);
+            murk_field_free(forced);
+        }
         murk_field_free(s);
         murk_field_free(d);
     }
     free(uni);
     free(ray);
+    if (getloadavg(load, 3) == 3)
+        printf("load average at the end %.2f %.2f %.2f\n", load[0], load[1], load[2]);
     return 0;
 }

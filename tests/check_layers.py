@@ -12,7 +12,9 @@ core/ a layer number. A file of folder F may include:
 Anything else fails: an include of a higher layer (upwards), of another folder of the same layer
 (sideways), a bare name ("util.h", which hides the direction), a folder the table does not list, a
 header that does not exist. A cycle of includes between core's own files fails too, and so does a
-folder with sources that the table misses (or a row naming no folder). The public headers are one ABI
+folder with sources that the table misses (or a row naming no folder), and, where the table has a column
+`files`, a C or C++ source of a folder that its row's files do not name (`policy_*.c` names a family), or a
+file named there that does not exist: the table is the map a newcomer reads. The public headers are one ABI
 apart from the layers: they may include each other (murk/medium.h and murk/transmittance.h do, on
 purpose, so that either brings both).
 
@@ -21,6 +23,7 @@ is checked on what the code calls: every symbol an object uses from another obje
 in its own folder or a lower layer's. That catches what an include cannot show: an `extern`
 declared by hand, like the counters global media.c once wrote in render/host.c.
 Exit 0 when all holds, 1 with one line per violation."""
+import fnmatch
 import os
 import re
 import subprocess
@@ -30,8 +33,9 @@ import tempfile
 INCLUDE = re.compile(r'^\s*#\s*include\s*"([^"]+)"', re.M)
 
 
-def read_table(readme):
-    """{folder: layer} from the markdown table whose header has the cells 'layer' and 'folder'."""
+def read_table(readme, files=None):
+    """{folder: layer} from the markdown table whose header has the cells 'layer' and 'folder'; with a dict
+    files, also {folder: [the `names` of its cell under 'files']} for a table with that column."""
     layers, cols = {}, None
     for line in open(readme, encoding='utf-8'):
         if not line.startswith('|'):
@@ -41,7 +45,7 @@ def read_table(readme):
         if cols is None:
             low = [c.lower() for c in cells]
             if 'layer' in low and 'folder' in low:
-                cols = (low.index('layer'), low.index('folder'))
+                cols = (low.index('layer'), low.index('folder'), low.index('files') if 'files' in low else None)
             continue
         if set(''.join(cells)) <= set('-: '):
             continue  # the |---|---| line
@@ -51,6 +55,8 @@ def read_table(readme):
         if folder in layers:
             raise SystemExit(f'{readme}: folder {folder}/ listed twice')
         layers[folder] = int(layer)
+        if files is not None and cols[2] is not None:
+            files[folder] = re.findall(r'`([^`]+)`', cells[cols[2]])
     if not layers:
         raise SystemExit(f'{readme}: no table headed | layer | folder | ...')
     return layers
@@ -112,6 +118,21 @@ def check_includes(core, layers):
     return bad, graph
 
 
+def check_files(core, named):
+    """The sources of each folder that its row's files cell does not name, and names that are no file."""
+    bad = []
+    for folder, names in sorted(named.items()):
+        have = sorted(os.path.relpath(os.path.join(d, n), os.path.join(core, folder))
+                      for d, _, ns in os.walk(os.path.join(core, folder)) for n in ns if n.endswith(('.c', '.cpp')))
+        for h in have:
+            if not any(fnmatch.fnmatchcase(h, n) for n in names):
+                bad.append(f'core/{folder}/{h}: core/README.md\'s layer table does not name it in {folder}/\'s files')
+        for n in names:
+            if n.endswith(('.c', '.cpp')) and not any(fnmatch.fnmatchcase(h, n) for h in have):
+                bad.append(f'core/README.md: {folder}/\'s files name {n}, which is no source of core/{folder}/')
+    return bad
+
+
 def find_cycle(graph):
     """One cycle of the graph as a list of nodes, or None (iterative depth-first search)."""
     state = {}
@@ -169,8 +190,10 @@ def check_symbols(libraries, layers):
 
 def check(root, libraries=()):
     core = os.path.join(root, 'core')
-    layers = read_table(os.path.join(core, 'README.md'))
+    named = {}
+    layers = read_table(os.path.join(core, 'README.md'), named)
     bad, graph = check_includes(core, layers)
+    bad += check_files(core, named)
     cycle = find_cycle(graph)
     if cycle:
         bad.append('a cycle of includes: ' + ' -> '.join('core/' + c for c in cycle))
@@ -183,8 +206,8 @@ def check(root, libraries=()):
 
 def self_test():
     """A small tree that passes, then one mutation each that must fail."""
-    table = '| layer | folder | what |\n|---|---|---|\n| 0 | `low/` | x |\n| 1 | `mid/` | x |\n' \
-            '| 1 | `side/` | x |\n| 2 | `top/` | x |\n'
+    table = '| layer | folder | what | files |\n|---|---|---|---|\n| 0 | `low/` | x | |\n| 1 | `mid/` | x | `b.c` |\n' \
+            '| 1 | `side/` | x | |\n| 2 | `top/` | x | `d.c` |\n'
     files = {'core/README.md': table, 'core/low/a.h': '', 'core/mid/b.h': '#include "low/a.h"\n',
              'core/side/c.h': '#include "low/a.h"\n', 'core/top/d.c': '#include "mid/b.h"\n#include "side/c.h"\n',
              'core/include/murk/p.h': '', 'core/mid/b.c': '#include "mid/b.h"\n#include "murk/p.h"\n'}
@@ -195,6 +218,7 @@ def self_test():
         'unlisted folder': ('core/extra/e.c', '#include "low/a.h"\n'),
         'public header leaks': ('core/include/murk/p.h', '#include "low/a.h"\n'),
         'missing header': ('core/top/d.c', '#include "mid/nothere.h"\n'),
+        'source the table does not name': ('core/mid/b2.c', '#include "mid/b.h"\n'),
         'cycle': ('core/mid/b.h', '#include "mid/b2.h"\n', 'core/mid/b2.h', '#include "mid/b.h"\n'),
     }
     failures = 0

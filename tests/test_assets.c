@@ -26,6 +26,8 @@
  *                OBJ mesh (block-wise z over independent seeds, stat.h); the other half emitting must differ.
  *   info lights  murk info lists the lights: block's spot and the glTF's point light, each with its origin.
  *   bad texture  a glTF whose texture file is missing: a located error naming it, no image.
+ *   resume       a checkpoint of a scene whose .gltf reads an external .bin buffer and an external PNG texture:
+ *                resumed while neither changed, refused after the .bin changed, and after the PNG changed.
  *   bad input    no mesh, a NaN vertex, a missing buffer, random bytes, truncated JSON, a PLY header without
  *                end_header (Assimp 5.2 hangs on it), a face of no vertices (Assimp 5.2 aborts), an unknown
  *                extension, a directory, from_asset naming a quad or an asset without a camera: `murk render`
@@ -799,6 +801,62 @@ static void test_scene(void **state)
     murk_image_free(&img);
 }
 
+/* ---- resume -------------------------------------------------------------------------------------------- */
+
+/* The checkpoint's content hash covers what an asset reads beside itself (load.c, asset.c): a scene of the gem
+ * as a .gltf with an external .bin buffer and the quad as a .gltf with an external PNG texture. Each step makes
+ * a fresh 2-spp checkpoint and resumes it: unchanged, it resumes; after the .bin changed (one vertex moved by
+ * 1/64, the same size), or the PNG (upside down), --resume is refused. */
+static void test_resume_inputs(void **state)
+{
+    (void)state;
+    need_assimp();
+    unsigned char b[128];
+    size_t nb = mesh_buffer(b, 0);
+    char text[8192], bin[600], png[600], scene[600], ck[600], exr[600];
+    snprintf(bin, sizeof bin, "%s", tmp_path("resume_gem.bin"));
+    write_file(bin, b, nb);
+    gltf_json(text, sizeof text, "resume_gem.bin", NULL, NULL, NULL, 1);
+    write_tmp("resume_gem.gltf", text);
+    snprintf(png, sizeof png, "%s", write_png("resume_tex.png", 8, 8, NULL, 0));
+    const char *mat = "{\"name\": \"painted\", \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, "
+                      "\"metallicFactor\": 0, \"roughnessFactor\": 0.5}}";
+    write_quad("resume_quad.gltf", mat, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"resume_tex.png\"}]",
+               NULL);
+    snprintf(scene, sizeof scene, "%s", write_tmp("resume.yaml",
+             "murk: 1\nrender: { resolution: [8, 8], spp: 4 }\n"
+             "camera: { from: [0.3, 0.8, 2.2], at: [0, 0.5, 0], fov: 40 }\n"
+             "materials:\n  white: { type: diffuse, albedo: 0.7 }\n"
+             "shapes:\n  - { type: quad, center: [0, 2, 0], u: [0.3, 0, 0], v: [0, 0, 0.3], material: white, "
+             "emission: [12, 12, 12] }\n"
+             "  - { type: asset, file: resume_gem.gltf, material: white }\n"
+             "  - { type: asset, file: resume_quad.gltf, material: from_file }\n"));
+    snprintf(ck, sizeof ck, "%s", tmp_path("resume.ck"));
+    snprintf(exr, sizeof exr, "%s", tmp_path("resume.exr"));
+    static const char *const what[] = {"nothing changed", "the .bin buffer changed", "the PNG texture changed"};
+    for (int step = 0; step < 3; step++) {
+        char *out = NULL;
+        const char *first[] = {"render", scene, "-o", exr, "--spp", "2", "--checkpoint", ck, "--quiet", NULL};
+        run_murk_ok(first, NULL);
+        if (step == 1) {
+            float y = V[5][1] + 1.0f / 64.0f; /* vertex 5's y, at byte 4 * (3 * 5 + 1) */
+            memcpy(b + 64, &y, 4);
+            write_file(bin, b, nb);
+        } else if (step == 2)
+            write_png("resume_tex.png", 8, 8, NULL, 1);
+        const char *again[] = {"render", scene, "-o", exr, "--resume", ck, "--quiet", NULL};
+        int rc = run_murk_argv(&out, again);
+        printf("  %-26s --resume: exit %d%s\n", what[step], rc, rc ? ", refused" : ", resumed");
+        if (step == 0)
+            assert_int_equal(rc, 0);
+        else {
+            assert_int_equal(rc, 1);
+            assert_contains(out, "a file it loads (mesh, grid, texture) changed since");
+        }
+        free(out);
+    }
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -813,6 +871,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_emission_texture),
         cmocka_unit_test(test_info_lights),
         cmocka_unit_test(test_bad_texture),
+        cmocka_unit_test(test_resume_inputs),
     };
     if (getenv("MURK_TEST_FILTER"))
         cmocka_set_test_filter(getenv("MURK_TEST_FILTER"));

@@ -10,11 +10,17 @@
  *   heavy     trap_heavy, unbounded weights in `mode: eager` (unbiased): the variance lines fail there
  *             (variance beyond 20x the analog estimator's), never in `mode: bounded`;
  *   estimator trap_tr_roulette, a transmittance estimator that keeps 1 estimate in 50 (x 50): its
- *             variance lines fail, nothing else.
+ *             variance lines fail, nothing else;
+ *   phase     trap_phase_edge, Henyey-Greenstein sampled from the wrong lobe beyond |g| 0.95 only: the
+ *             sweep points g = -0.99 and 0.99 fail their sampled mean cosine, nothing else (the phase
+ *             checks once skipped a range's ends).
+ * A plugin with more sweep points than murk check runs (CK_MAX_SETS) is told so, never silently cut
+ * (ck_param_sets, called directly).
  * And the output: a PASS line never shows |z| > 4 (zero-variance figures say they were compared
  * exactly); NaN is named; a missing plugin and a crashing one give a FAIL line with the reason, the
  * summary line and exit 1. All deterministic: murk check's seeds are fixed. */
 #include "testutil.h"
+#include "lab/check/sweep.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -125,6 +131,50 @@ static void test_estimator(void **state)
     free(out);
 }
 
+/* A phase function wrong only near |g| = 1: its two sweep points fail, on the mean cosine alone. */
+static void test_phase_edge(void **state)
+{
+    (void)state;
+    char *out = NULL;
+    int rc = check(&out, "trap_phase_edge", NULL);
+    printf("%s", out);
+    assert_int_equal(rc, 1);
+    assert_contains(out, "g: -0.99, its minimum (the others at their defaults)");
+    assert_contains(out, "g: 0.99, its maximum (the others at their defaults)");
+    assert_int_equal(fails_only(out, ", its m", "mean cos"), 2);
+    free(out);
+    rc = check(&out, "trap_phase_edge", "g=0.9");
+    assert_int_equal(rc, 0);
+    free(out);
+}
+
+/* 30 float parameters: 3 full sets and 60 range ends do not fit into CK_MAX_SETS; the count left out is
+ * said. 20 fit (43 sets) and nothing is said. */
+static void test_sweep_overflow(void **state)
+{
+    (void)state;
+    static murk_param params[30];
+    static char names[30][8];
+    for (int i = 0; i < 30; i++) {
+        snprintf(names[i], sizeof names[i], "p%d", i);
+        params[i] = (murk_param){names[i], MURK_PARAM_FLOAT, 0, {0.5, 0, 0}, NULL, NULL, 0.0, 1.0, "x"};
+    }
+    murk_plugin_desc d = {sizeof d, MURK_KIND_MATERIAL, "many", "many parameters", params, 30, NULL, NULL};
+    static ck_set sets[CK_MAX_SETS];
+    char err[512];
+    int n = ck_param_sets(&d, NULL, 0, sets, CK_MAX_SETS, err, sizeof err);
+    printf("30 parameters: %d sets, '%s'\n", n, err);
+    assert_int_equal(n, CK_MAX_SETS);
+    char want[128];
+    snprintf(want, sizeof want, "%d sweep points beyond the first %d parameter sets not run", 3 + 60 - CK_MAX_SETS,
+             CK_MAX_SETS);
+    assert_contains(err, want);
+    d.nparams = 20;
+    n = ck_param_sets(&d, NULL, 0, sets, CK_MAX_SETS, err, sizeof err);
+    assert_int_equal(n, 43);
+    assert_string_equal(err, "");
+}
+
 /* No PASS line shows a z beyond the bound; zero-variance figures say how they were compared. */
 static void test_honest_pass(void **state)
 {
@@ -172,7 +222,8 @@ static void test_honest_fail(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_rate), cmocka_unit_test(test_gain), cmocka_unit_test(test_heavy),
-                                       cmocka_unit_test(test_estimator),
+                                       cmocka_unit_test(test_estimator), cmocka_unit_test(test_phase_edge),
+                                       cmocka_unit_test(test_sweep_overflow),
                                        cmocka_unit_test(test_honest_pass), cmocka_unit_test(test_honest_fail)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,5 @@
 /* test_envlights.c — the lights of the `lights:` block (render/lights.h) against closed forms, each
- * check with a must-fail twin that shows it sees a 1 % error (2 % for env_mis):
+ * check with a must-fail twin that shows it sees a 1 % error:
  *
  *   envmap_chi2        directions sampled by light sampling from a scene holding one environment map
  *                      (constant, one bright texel, a gradient; rotated 30 degrees), binned by texel
@@ -12,13 +12,18 @@
  *                      a direction reads is the one envmap.h's mapping names.
  *   env_mis            the irradiance a point receives from an envmap plus a sun of 10 degrees, by light
  *                      sampling alone, by cosine sampling alone and by their power-heuristic MIS: the
- *                      three agree within 5 sigma (independent streams); light sampling with its pdf 2 %
- *                      too high does not (must-fail; 1 % is only 6 of its standard errors at 10^6 samples).
+ *                      three agree within 5 sigma (independent streams); light sampling with its pdf 1 %
+ *                      too high does not (must-fail; MIS and the mutant with 4 x 10^6 samples, where 1 %
+ *                      is 12 to 19 of their standard errors).
  *   point_spot         a point light's and a spot's irradiance at points of a plane by light sampling
  *                      (delta: exact) against I cos / r^2 times pbrt-v4's smoothstep, to 1e-5; 1.01 x the
  *                      closed form fails.
+ *   selection_by_power a point, a spot, a delta sun and an envmap in one scene are chosen in the ratios of
+ *                      their powers (the bounding radius cancelled), exactly (1e-5); 1.01 x fails.
  *   furnace            a white diffuse sphere under a constant envmap renders the map's radiance (mean
- *                      over the image within 5 sigma of 1); an albedo-0.99 sphere is rejected (must-fail).
+ *                      over the image within 5 sigma of 1); an albedo-0.99 sphere is rejected (must-fail);
+ *                      so does a map of half that radiance beside a constant `background` of the other
+ *                      half (the background then sampled as a part of the environment); 1.01 x fails.
  *   sun_plane          a diffuse plane under a distant light renders albedo / pi E cos theta: exactly for
  *                      a delta sun, within 5 sigma for a 40-degree cone above the horizon and for one that
  *                      the horizon cuts (the closed form integrated numerically); 1.01 x fails (must-fail).
@@ -26,10 +31,16 @@
  *                      exp(-sigma_t d / cos theta), for every tracker's own transmittance and every
  *                      transmittance estimator (the shadow ray runs to infinity through the slab's box);
  *                      1.01 x fails.
+ *   equiangular_punctual volpath_nee's single scattering (max_depth 1) of a point and of a spot light
+ *                      along one ray through a grey homogeneous medium, equiangular sampling towards the
+ *                      light on and off, against the integral along the ray (midpoint rule); 1.01 x fails.
  *   legacy             an integrator of ABI 1.6 gets only the emissive shapes to sample, never more than
  *                      its struct, and is refused a scene with a delta light; background() still
  *                      holds the environment.
- *   bad_input          each bad light is a located error and writes nothing.
+ *   bad_input          each bad light is a located error and writes nothing (an envmap that is not
+ *                      lat-long, not an EXR, empty, has a NaN, infinite or negative texel, or is over the
+ *                      image limit; a direction of length 0; a diameter of 180; a spot cone narrower than
+ *                      its falloff); a sun below the horizon renders black with a warning.
  * Fixed seeds throughout; every statistical decision goes through stat.h (5 sigma, chi-square p >= 1e-6,
  * counted for the suite's family-wise rate in tests/README.md). */
 #include "stat.h"
@@ -261,9 +272,11 @@ static void test_env_mis(void **state)
     const murk_vec3 normals[2] = {murk_normalize(murk_v3(0.1f, 1, 0.3f)), murk_normalize(murk_v3(1, 0.2f, -0.4f))};
     for (int q = 0; q < 2; q++) {
         double m[3], e[3], mb, eb;
+        /* MIS and the mutant with 4x the samples, so that a 1 % error is ~13 of their standard errors */
         for (int tech = 0; tech < 3; tech++)
-            irradiance(s, normals[q], tech, 1.0, stat_n(1000000), 5 + (uint64_t)q, &m[tech], &e[tech]);
-        irradiance(s, normals[q], 0, 1.02, stat_n(1000000), 7 + (uint64_t)q, &mb, &eb);
+            irradiance(s, normals[q], tech, 1.0, stat_n(tech == 2 ? 4000000 : 1000000), 5 + (uint64_t)q, &m[tech],
+                       &e[tech]);
+        irradiance(s, normals[q], 0, 1.01, stat_n(4000000), 7 + (uint64_t)q, &mb, &eb);
         double z01 = (m[0] - m[1]) / hypot(e[0], e[1]), z21 = (m[2] - m[1]) / hypot(e[2], e[1]),
                z20 = (m[2] - m[0]) / hypot(e[2], e[0]), zb = (mb - m[2]) / hypot(eb, e[2]);
         printf("normal %d: light %.5f +- %.5f, cosine %.5f +- %.5f, MIS %.5f +- %.5f; z light-cosine %+.2f, "
@@ -273,7 +286,7 @@ static void test_env_mis(void **state)
         assert_true(stat_z_ok(m[2] - m[1], hypot(e[2], e[1]), 0.0, 0.0));
         assert_true(stat_z_ok(m[2] - m[0], hypot(e[2], e[0]), 0.0, 0.0));
         char label[96];
-        snprintf(label, sizeof label, "env MIS, normal %d: light sampling's pdf 1.02 x", q);
+        snprintf(label, sizeof label, "env MIS, normal %d: light sampling's pdf 1.01 x", q);
         assert_true(stat_must_fail(label, fabs(zb) > STAT_Z, zb));
     }
     murk_scene_free(s);
@@ -319,6 +332,45 @@ static void test_point_spot(void **state)
            nonzero);
     assert_int_equal(bad, 0);
     assert_int_equal(bad_mutant, nonzero);
+}
+
+/* ---- selection by power ------------------------------------------------------------------------------ */
+
+/* A point (I 1), a spot (I 2, cone 40, falloff 20), a delta sun (E 3) and a constant envmap (L 1) in one
+ * scene: their probabilities of being chosen are in the ratios of their powers (lights.h): 4 I, 2 I (1 -
+ * (cos falloff + cos cone) / 2), E R^2 and R^2 x the map's integral over directions (its midpoint sum over
+ * the rows, ~4 pi), R the scene's bounding radius (cancelled in the ratios checked), and sum to 1. To 1e-5;
+ * a 1 % error in any ratio is seen. */
+static void test_selection_by_power(void **state)
+{
+    (void)state;
+    float rgb[3 * MW * MH];
+    char lights[1024];
+    snprintf(lights, sizeof lights,
+             "  - { type: point, position: [0, 2, 0], intensity: 1 }\n"
+             "  - { type: spot, position: [0, 2, 0], direction: [0, -1, 0], intensity: 2, cone_angle: 40, "
+             "falloff_angle: 20 }\n"
+             "  - { type: distant, direction: [0, 1, 0], irradiance: 3 }\n"
+             "  - { type: envmap, file: %s }\n", write_map(MAP_CONSTANT, rgb));
+    murk_scene *s = lights_scene("power.yaml", lights);
+    assert_int_equal(s->nlights, 4);
+    double rows = 0.0;
+    for (int j = 0; j < MH; j++)
+        rows += sin(M_PI * (j + 0.5) / MH);
+    double integral = rows * MW * (2.0 * M_PI / MW) * (M_PI / MH);
+    double spot = 2.0 * 2.0 * (1.0 - 0.5 * (cos(20 * M_PI / 180) + cos(40 * M_PI / 180)));
+    double got[3] = {s->lights[1].pmf / s->lights[0].pmf, s->lights[3].pmf / s->lights[2].pmf,
+                     (double)s->lights[0].pmf + s->lights[1].pmf + s->lights[2].pmf + s->lights[3].pmf};
+    double want[3] = {spot / 4.0, integral / 3.0, 1.0};
+    const char *what[3] = {"spot / point", "envmap / sun", "sum"};
+    for (int k = 0; k < 3; k++) {
+        printf("%-12s %.7f (power ratio %.7f)\n", what[k], got[k], want[k]);
+        assert_true(fabs(got[k] / want[k] - 1.0) < 1e-5);
+        assert_false(fabs(got[k] / (1.01 * want[k]) - 1.0) < 1e-5);
+    }
+    printf("the scene's radius from the point and the sun: R = %.4f\n",
+           sqrt((double)s->lights[2].pmf / s->lights[0].pmf * 4.0 / 3.0));
+    murk_scene_free(s);
 }
 
 /* ---- images ---------------------------------------------------------------------------------------- */
@@ -368,22 +420,25 @@ static void test_furnace(void **state)
     float rgb[3 * MW * MH];
     char text[1024];
     const char *map = write_map(MAP_CONSTANT, rgb);
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) { /* 2: half the radiance from the map, half from a constant background */
         snprintf(text, sizeof text,
-                 "murk: 1\nrender: { resolution: [32, 32], spp: 64, seed: 1 }\n"
+                 "murk: 1\nrender: { resolution: [32, 32], spp: 64, seed: 1 }\n%s"
                  "camera: { from: [0, 0, 4], at: [0, 0, 0], up: [0, 1, 0], fov: 25 }\n"
                  "integrator: { type: volpath_nee }\nmaterials: { w: { type: diffuse, albedo: %s } }\n"
-                 "lights: [ { type: envmap, file: %s } ]\n"
+                 "lights: [ { type: envmap, file: %s, scale: %s } ]\n"
                  "shapes: [ { type: sphere, center: [0, 0, 0], radius: 1, material: w } ]\n",
-                 k ? "0.99" : "1", map);
+                 k == 2 ? "background: 0.5\n" : "", k == 1 ? "0.99" : "1", map, k == 2 ? "0.5" : "1");
         double m, se;
         render_mean("furnace.yaml", text, NULL, &m, &se);
         double z = (m - 1.0) / se;
-        printf("white furnace, albedo %s: %.6f +- %.6f (z %+.2f against 1)\n", k ? "0.99" : "1", m, se, z);
+        printf("white furnace, albedo %s%s: %.6f +- %.6f (z %+.2f against 1)\n", k == 1 ? "0.99" : "1",
+               k == 2 ? ", map 0.5 + background 0.5" : "", m, se, z);
         if (k == 0)
             assert_true(stat_z_ok(m, se, 1.0, 0.0));
-        else /* the 1 %-darker sphere is seen */
+        else if (k == 1) /* the 1 %-darker sphere is seen */
             assert_true(stat_must_fail("white furnace with albedo 0.99", fabs(z) > STAT_Z, z));
+        else /* the constant background sampled as one more part of the environment */
+            check_closed_form("furnace, map 0.5 + background 0.5", m, se, 1.0, 0.0);
     }
 }
 
@@ -460,6 +515,61 @@ static void test_slab(void **state)
         snprintf(label, sizeof label, "slab: %s%s%s", variants[v][0], variants[v][1] ? " + " : "",
                  variants[v][1] ? variants[v][1] : "");
         check_closed_form(label, m, se, want, 3e-4); /* two crossings' offsets: 1.3e-4 of the optical depth */
+    }
+}
+
+/* ---- equiangular sampling towards point and spot lights ---------------------------------------------- */
+
+/* Single scattering of a point (spot = 0) or spot light at (0, 1, -2) along the ray from the origin down
+ * -z through a grey homogeneous medium (sigma_s 0.5, sigma_t 0.6, isotropic) that ends at z = -10: the
+ * integral over t of sigma_s exp(-sigma_t t) I f(t) exp(-sigma_t r) / (4 pi r^2), r the distance from
+ * the ray's point to the light, f the spot's smoothstep in the cosine of its angle from the axis
+ * (straight down; cone 40, falloff 20 degrees), by the midpoint rule (1e6 steps: exact to ~1e-9). */
+static double single_scatter(int spot)
+{
+    const double ss = 0.5, st = 0.6, cc = cos(40 * M_PI / 180), cf = cos(20 * M_PI / 180);
+    const int n = 1000000;
+    double sum = 0.0, dt = 10.0 / n;
+    for (int i = 0; i < n; i++) {
+        double t = (i + 0.5) * dt, r2 = 1.0 + (t - 2.0) * (t - 2.0), r = sqrt(r2), f = 1.0;
+        if (spot) {
+            double c = 1.0 / r, x = (c - cc) / (cf - cc);
+            f = c >= cf ? 1.0 : c <= cc ? 0.0 : x * x * (3 - 2 * x);
+        }
+        sum += ss * exp(-st * (t + r)) * f / (4.0 * M_PI * r2);
+    }
+    return sum * dt;
+}
+
+/* volpath_nee at max_depth 1 (single scattering) renders that integral with equiangular sampling on
+ * (towards the light's position) and off (free flights alone), for a point and a spot light: the camera
+ * sits in the medium with a 0.01-degree field of view, so every pixel is an independent sample of the
+ * one ray. Must fail: 1.01 x the closed form. */
+static void test_equiangular_punctual(void **state)
+{
+    (void)state;
+    static const char *const lights[2] = {
+        "{ type: point, position: [0, 1, -2], intensity: 1 }",
+        "{ type: spot, position: [0, 1, -2], direction: [0, -1, 0], intensity: 1, cone_angle: 40, falloff_angle: 20 }"};
+    for (int spot = 0; spot < 2; spot++) {
+        double want = single_scatter(spot);
+        for (int eq = 1; eq >= 0; eq--) {
+            char text[2048], label[64];
+            snprintf(text, sizeof text,
+                     "murk: 1\nrender: { resolution: [32, 32], spp: 128, seed: %d }\n"
+                     "camera: { from: [0, 0, 0], at: [0, 0, -1], up: [0, 1, 0], fov: 0.01, medium: fog }\n"
+                     "integrator: { type: volpath_nee, max_depth: 1, equiangular: %s }\n"
+                     "media: { fog: { type: delta, density: { constant: 1 }, sigma_a: [0.1, 0.1, 0.1], "
+                     "sigma_s: [0.5, 0.5, 0.5], g: 0 } }\n"
+                     "lights: [ %s ]\n"
+                     "shapes: [ { type: box, min: [-10, -10, -10], max: [10, 10, 10], interior: fog } ]\n",
+                     3 + 2 * spot + eq, eq ? "true" : "false", lights[spot]);
+            const char *extra[] = {"--spp", eq ? "128" : "1024", NULL};
+            double m, se;
+            render_mean("eq_punctual.yaml", text, extra, &m, &se);
+            snprintf(label, sizeof label, "%s light, equiangular %s", spot ? "spot" : "point", eq ? "on" : "off");
+            check_closed_form(label, m, se, want, 3e-4); /* the rays' offsets, as in test_slab */
+        }
     }
 }
 
@@ -560,6 +670,19 @@ static void test_bad_input(void **state)
     check_refused("big.yaml", "  - { type: envmap, file: big.exr }\n", "MURK_MAX_IMAGE_PIXELS");
     unsetenv("MURK_MAX_IMAGE_PIXELS");
     check_refused("missing.yaml", "  - { type: envmap, file: none.exr }\n", "missing.yaml:4:27: lights[0] (envmap): ");
+    /* not an EXR at all: a text file and an empty one under the name */
+    write_tmp("text.exr", "this is not an OpenEXR file\n");
+    check_refused("text.yaml", "  - { type: envmap, file: text.exr }\n", "text.yaml:4:27: lights[0] (envmap): ");
+    write_tmp("empty.exr", "");
+    check_refused("empty.yaml", "  - { type: envmap, file: empty.exr }\n", "empty.yaml:4:27: lights[0] (envmap): ");
+    /* a 0 x 0 map (OpenEXR cannot hold one: the C adder a loader of another format would call) */
+    murk_scene *s = lights_scene("zero.yaml", "  - { type: point, position: [0, 2, 0], intensity: 1 }\n");
+    size_t before = s->nadded;
+    assert_int_equal(murk_lights_add_envmap_rgb(s, rgb, 0, 0, murk_rgb1(1.0f), 0.0, err, sizeof err), -1);
+    printf("0 x 0 map: %s\n", err);
+    assert_contains(err, "the environment map is empty (0x0)");
+    assert_int_equal(s->nadded, before);
+    murk_scene_free(s);
     check_refused("zero_dir.yaml", "  - { type: distant, direction: [0, 0, 0], irradiance: 1 }\n",
                   "zero_dir.yaml:4:33: lights[0] (distant): direction has no length");
     check_refused("diam.yaml", "  - { type: distant, direction: [0, 1, 0], irradiance: 1, angular_diameter: 180 }\n",
@@ -571,6 +694,10 @@ static void test_bad_input(void **state)
     check_refused("type.yaml", "  - { type: spto, position: [0, 2, 0] }\n",
                   "type.yaml:4:13: lights[0]: unknown light type 'spto' (did you mean 'spot'?)");
     check_refused("key.yaml", "  - { type: point, position: [0, 2, 0], intensty: 1 }\n", "(did you mean 'intensity'?)");
+    check_refused("sun_dir.yaml", "  - { type: sky, sun_direction: [0, 0, 0] }\n",
+                  "sun_dir.yaml:4:33: lights[0] (sky): sun_direction has no length");
+    check_refused("sun_bool.yaml", "  - { type: sky, sun_direction: [0, 1, 0], sun: maybe }\n",
+                  "sun_bool.yaml:4:49: lights[0] (sky): sun must be true or false");
     check_refused("turbidity.yaml", "  - { type: sky, sun_direction: [0, 1, 0], turbidity: 20 }\n",
                   "turbidity.yaml:4:55: lights[0] (sky): turbidity must be in [1.7, 10]");
     /* a sun below the horizon is allowed: a warning, a black sky, no sun */
@@ -593,9 +720,11 @@ static void test_bad_input(void **state)
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_envmap_chi2), cmocka_unit_test(test_envmap_pdf), cmocka_unit_test(test_env_mis),
-        cmocka_unit_test(test_point_spot),  cmocka_unit_test(test_furnace),    cmocka_unit_test(test_sun_plane),
-        cmocka_unit_test(test_slab),        cmocka_unit_test(test_legacy),     cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_envmap_chi2),        cmocka_unit_test(test_envmap_pdf), cmocka_unit_test(test_env_mis),
+        cmocka_unit_test(test_point_spot),         cmocka_unit_test(test_selection_by_power),
+        cmocka_unit_test(test_furnace),            cmocka_unit_test(test_sun_plane),
+        cmocka_unit_test(test_slab),               cmocka_unit_test(test_equiangular_punctual),
+        cmocka_unit_test(test_legacy),             cmocka_unit_test(test_bad_input),
     };
     return STAT_RUN(tests, argc, argv);
 }

@@ -1,6 +1,8 @@
-/* test_gallery.c — the gallery's final scene, scenes/axe_room.yaml, and its generated assets:
- *  - the scene loads and renders a few spp at a tiny resolution with every pixel finite and >= 0 and
+/* test_gallery.c — the gallery's final scene, scenes/axe_room.yaml, and its generated assets, and the
+ * gallery's three scenes of lights (envmap_spheres, spot_fog, cloud_sun) and their environment map:
+ *  - each scene loads and renders a few spp at a tiny resolution with every pixel finite and >= 0 and
  *    no NaN/inf sample dropped (the EXR records how many were);
+ *  - tools/make_envmap.py is deterministic and writes the committed scenes/env/studio.exr;
  *  - tools/make_axe.py and tools/make_textures.py are deterministic: two runs write the same bytes,
  *    and those are the bytes committed in scenes/axe/;
  *  - the axe head is a closed, outward-wound mesh (every directed edge once, its reverse once, positive
@@ -182,21 +184,24 @@ static void assert_closed(const char *name, const obj *o)
 
 /* ---- tests ------------------------------------------------------------------------------------ */
 
-static void test_axe_scene_renders(void **state)
+/* Renders scenes/NAME.yaml at w x h and 4 spp: every pixel finite and >= 0, some light, no NaN/inf sample
+ * dropped, and the scene's own integrator (volpath_nee for all of the gallery's). */
+static void scene_renders(const char *name, int w, int h)
 {
-    (void)state;
-    char exr[1024], *log = NULL, err[512];
-    snprintf(exr, sizeof exr, "%s/axe_room.exr", tmp_dir());
-    int rc = run_murk(&log, "render", src_path("scenes/axe_room.yaml"), "-o", exr, "--spp", "4", "--set",
-                      "render.resolution=[40,30]", "--quiet", (char *)NULL);
+    char scene[1024], exr[1024], res[64], *log = NULL, err[512];
+    snprintf(scene, sizeof scene, "scenes/%s.yaml", name);
+    snprintf(scene, sizeof scene, "%s", src_path(scene));
+    snprintf(exr, sizeof exr, "%s/%s.exr", tmp_dir(), name);
+    snprintf(res, sizeof res, "render.resolution=[%d,%d]", w, h);
+    int rc = run_murk(&log, "render", scene, "-o", exr, "--spp", "4", "--set", res, "--quiet", (char *)NULL);
     if (rc)
         fprintf(stderr, "%s\n", log);
     assert_int_equal(rc, 0);
     free(log);
     murk_image img = {0};
     assert_int_equal(murk_exr_read(exr, &img, err, sizeof err), 0);
-    assert_int_equal(img.w, 40);
-    assert_int_equal(img.h, 30);
+    assert_int_equal(img.w, w);
+    assert_int_equal(img.h, h);
     double sum = 0.0;
     for (int i = 0; i < 3 * img.w * img.h; i++) {
         assert_true(isfinite(img.rgb[i]));
@@ -205,14 +210,38 @@ static void test_axe_scene_renders(void **state)
     }
     const char *nonfinite = murk_image_meta(&img, "murk:nonfinite_samples");
     const char *integrator = murk_image_meta(&img, "murk:integrator");
-    printf("axe_room 40x30, 4 spp: mean %.4f, nonfinite samples %s, integrator %s\n", sum / (3.0 * img.w * img.h),
-           nonfinite ? nonfinite : "?", integrator ? integrator : "?");
+    printf("%s %dx%d, 4 spp: mean %.4f, nonfinite samples %s, integrator %s\n", name, w, h,
+           sum / (3.0 * img.w * img.h), nonfinite ? nonfinite : "?", integrator ? integrator : "?");
     assert_true(sum > 0.0);
     assert_non_null(nonfinite);
     assert_string_equal(nonfinite, "0");
     assert_non_null(integrator);
     assert_string_equal(integrator, "volpath_nee");
     murk_image_free(&img);
+}
+
+static void test_axe_scene_renders(void **state)
+{
+    (void)state;
+    scene_renders("axe_room", 40, 30);
+}
+
+/* The gallery's three scenes of the `lights:` block (an envmap, a spot in fog, a cloud under the sky),
+ * and scenes/env/studio.exr: tools/make_envmap.py writes the same bytes twice, and they are the bytes
+ * committed. */
+static void test_lights_scenes(void **state)
+{
+    (void)state;
+    scene_renders("envmap_spheres", 24, 14);
+    scene_renders("spot_fog", 16, 16);
+    scene_renders("cloud_sun", 20, 15);
+    const char *out[2] = {path_in(tmp_dir(), "studio1.exr"), path_in(tmp_dir(), "studio2.exr")};
+    for (int r = 0; r < 2; r++)
+        assert_int_equal(run_python(src_path("tools/make_envmap.py"), out[r]), 0);
+    assert_same_file(out[0], out[1]);
+    char committed[1024];
+    snprintf(committed, sizeof committed, "%s", src_path("scenes/env/studio.exr"));
+    assert_same_file(out[0], committed);
 }
 
 static void test_generators_deterministic(void **state)
@@ -319,6 +348,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_axe_scene_renders),
+        cmocka_unit_test(test_lights_scenes),
         cmocka_unit_test(test_generators_deterministic),
         cmocka_unit_test(test_axe_meshes),
         cmocka_unit_test(test_textures),

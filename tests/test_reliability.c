@@ -11,6 +11,7 @@
 #include "testutil.h"
 
 #include <dirent.h>
+#include <dlfcn.h>
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -211,6 +212,19 @@ static void fake_warn_once(const char *fmt, ...)
 }
 static void *fake_alloc(size_t n) { return calloc(1, n); }
 
+/* The host services a tracker's collision loop uses, over the fake walk above. */
+static void fake_host(murk_host *h)
+{
+    memset(h, 0, sizeof *h);
+    h->size = sizeof *h;
+    h->alloc = fake_alloc;
+    h->free = free;
+    h->density = fake_density;
+    h->walk_init = fake_walk_init;
+    h->walk_next = fake_walk_next;
+    h->warn_once = fake_warn_once;
+}
+
 /* The collision loop had no progress guard: a step below the float spacing of t left t where it was,
  * forever. Now t advances by at least one float and the watchdog stops the flight at
  * MURK_WATCHDOG_ITERATIONS, naming the tracker and the medium. Bounded by alarm(). */
@@ -218,14 +232,7 @@ static void t_tracker_progress_and_watchdog(void **state)
 {
     (void)state;
     murk_host h;
-    memset(&h, 0, sizeof h);
-    h.size = sizeof h;
-    h.alloc = fake_alloc;
-    h.free = free;
-    h.density = fake_density;
-    h.walk_init = fake_walk_init;
-    h.walk_next = fake_walk_next;
-    h.warn_once = fake_warn_once;
+    fake_host(&h);
     murk_medium_data d = {sizeof d, murk_rgb1(0.0f), murk_rgb1(1e10f), 0.0f, NULL, "m", 0, 0, 0};
     char err[128];
     murk_tracker *t = murk_tracker_new(&h, &d, sizeof *t, err, sizeof err);
@@ -262,6 +269,45 @@ static void t_tracker_progress_and_watchdog(void **state)
     assert_true(T.c[0] == 0.0f);
     alarm(0);
     free(t);
+}
+
+/* The SDK's example tracker (plugins/examples/example_delta.c, built in-tree into tests/fixtures) does
+ * what docs/plugins.md asks of every tracker at the watchdog's cap: its warning names it (base.plugin),
+ * not '?', and the flight ends the path (c.stopped: weight 0), never passes the segment on. */
+static void t_example_tracker_watchdog(void **state)
+{
+    (void)state;
+    void *so = dlopen(build_path("tests/fixtures/example_delta.so"), RTLD_NOW | RTLD_LOCAL);
+    if (!so)
+        fail_msg("dlopen example_delta.so: %s", dlerror());
+    const murk_plugin_desc *(*entry)(void);
+    *(void **)&entry = dlsym(so, MURK_PLUGIN_ENTRY_SYMBOL);
+    assert_non_null(entry);
+    const murk_medium_vt *vt = entry()->vtable;
+    murk_host h;
+    fake_host(&h);
+    murk_medium_data d = {sizeof d, murk_rgb1(0.0f), murk_rgb1(1e10f), 0.0f, NULL, "m", 0, 0, 0};
+    char err[256];
+    void *self = NULL;
+    assert_int_equal(vt->create(&h, &d, NULL, &self, err, sizeof err), 0);
+    murk_ray ray = {murk_v3(0, 0, 0), murk_v3(0, 0, 1), 0.0f, INFINITY};
+    murk_path_ctx ctx = {.hero = 0, .beta = {{1, 1, 1}}};
+    murk_rng rng;
+    murk_rng_seed(&rng, 1, 2, 3);
+    murk_medium_event ev;
+    alarm(60);
+    fake_t0 = 1.0f, fake_t1 = INFINITY, fake_dmax = 1e10f;
+    fake_warning[0] = 0;
+    vt->sample(self, &ray, &ctx, &rng, &ev);
+    alarm(0);
+    printf("example_delta at the watchdog's cap: scattered %d, weight %g, '%s'\n", ev.scattered, (double)ev.weight.c[0],
+           fake_warning);
+    assert_string_equal(fake_warning, "tracker 'example_delta' (medium 'm'): a free flight exceeded 16777216 iterations "
+                                      "(MURK_WATCHDOG_ITERATIONS); the path was ended (biased)");
+    assert_int_equal(ev.scattered, 1);
+    assert_true(murk_rgb_is_black(ev.weight));
+    vt->destroy(self);
+    dlclose(so);
 }
 
 /* ---- 2. declared sizes and endless input --------------------------------------------------- */
@@ -620,6 +666,7 @@ int main(void)
         cmocka_unit_test(t_camera_far),
         cmocka_unit_test(t_ray_range),
         cmocka_unit_test(t_tracker_progress_and_watchdog),
+        cmocka_unit_test(t_example_tracker_watchdog),
         cmocka_unit_test(t_png_declared_size),
         cmocka_unit_test(t_exr_declared_size),
         cmocka_unit_test(t_devices_and_fifos),

@@ -7,6 +7,10 @@
  *                      voxels, bound grids, and murk_field_eval bit for bit at 300 000 points (random, voxel
  *                      centres, brick faces, the box's faces); the comparison itself must see a 1-ulp change
  *                      of one voxel (must-fail).
+ *   held dense         sparse.c's rule: the bench's fully active 128^3 checker is held dense (its dense form is
+ *                      within 1/16 of its sparse form), and gives bitwise the lookups, voxels and bound grids of it
+ *                      held sparse (axis-aligned and rotated maps; must-fail: a voxel 1 ulp higher); a ball of 3 %
+ *                      of its box stays sparse and equals its dense form the same way.
  *   inactive, tiles    inactive voxels read 0 whatever they hold; a tile's value at its borders; a leaf of one
  *                      value and a tile share one brick; the builder's errors (a negative, a NaN, a leaf met
  *                      twice or outside the box, a box too large) each say what and where.
@@ -122,7 +126,18 @@ static plan_item *plan_grid(uint64_t seed, const int org[3], const int nb[3], in
     return it;
 }
 
-static murk_field *build_plan(const plan_item *it, int n, const int amin[3], const int amax[3], const double map[12])
+/* murk_sparse_finish, failing the test on an error. */
+static murk_field *finish(murk_sparse_build *b, const double map[12], int hold)
+{
+    murk_field *f = murk_sparse_finish(b, map, hold, err, sizeof err);
+    if (!f)
+        fail_msg("%s", err);
+    return f;
+}
+
+/* The grid of the plan, held as `hold` says (MURK_HOLD_SPARSE: the brick structure under test). */
+static murk_field *build_plan(const plan_item *it, int n, const int amin[3], const int amax[3], const double map[12],
+                              int hold)
 {
     murk_sparse_build *b = murk_sparse_begin("plan", amin, amax, err, sizeof err);
     if (!b)
@@ -135,10 +150,7 @@ static murk_field *build_plan(const plan_item *it, int n, const int amin[3], con
             fail_msg("%s", err);
         }
     }
-    murk_field *f = murk_sparse_end(b, map, err, sizeof err);
-    if (!f)
-        fail_msg("%s", err);
-    return f;
+    return finish(b, map, hold);
 }
 
 static int same_float(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
@@ -217,7 +229,7 @@ static void test_sparse_equals_dense(void **state)
     for (int c = 0; c < 3; c++) {
         int n, amin[3], amax[3];
         plan_item *it = plan_grid(100 + (uint64_t)c, origins[c], blocks[c], &n, amin, amax);
-        murk_field *s = build_plan(it, n, amin, amax, MAP_SCALED);
+        murk_field *s = build_plan(it, n, amin, amax, MAP_SCALED, MURK_HOLD_SPARSE);
         murk_field *d = dense_copy(s, "sparse_dense.vol");
         int rs[3], rd[3];
         const float *data;
@@ -294,7 +306,8 @@ static void test_inactive_and_tiles(void **state)
     assert_int_equal(murk_sparse_tile(b, o3, 8, 1.25f, err, sizeof err), 0);
     assert_int_equal(murk_sparse_leaf(b, o4, v, none, err, sizeof err), 0); /* no active voxel: nothing */
     static const double ident[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-    murk_field *f = murk_sparse_end(b, ident, err, sizeof err);
+    murk_field *f = murk_sparse_finish(b, ident, MURK_HOLD_SPARSE, err, sizeof err); /* its 18 x 18 x 10 box is
+                                                                                        smaller dense */
     assert_non_null(f);
     /* box voxel (x, y, z) is index (x - 1, y - 1, z - 1); index ijk's value sits at world ijk */
     for (int i = 0; i < 512; i++) {
@@ -321,6 +334,127 @@ static void test_inactive_and_tiles(void **state)
     assert_int_equal(fi.active, 256 + 3 * 512);
     assert_true(fi.sparse && fi.grid && !fi.transformed);
     murk_field_free(f);
+}
+
+/* ---- the form a grid is held in ------------------------------------------------------------------ */
+
+/* A grid through the builder, held as `hold` says: full, the bench's 128^3 checker of 0.2 / 1.4 (varied per voxel,
+ * so that no two bricks are alike) with every voxel active; otherwise a ball of 3 % of a 128^3 box (radius 24.7
+ * voxels, and a voxel at two opposite corners so that the box spans 128^3). */
+static murk_field *build_form(int full, const double map[12], int hold)
+{
+    int amin[3] = {0, 0, 0}, amax[3] = {127, 127, 127};
+    murk_sparse_build *b = murk_sparse_begin("form", amin, amax, err, sizeof err);
+    if (!b)
+        fail_msg("%s", err);
+    float v[512];
+    uint64_t mask[8];
+    for (int x = 0; x < 128; x += 8)
+        for (int y = 0; y < 128; y += 8)
+            for (int z = 0; z < 128; z += 8) {
+                memset(mask, 0, sizeof mask);
+                for (int i = 0; i < 512; i++) {
+                    int c[3] = {x + (i >> 6), y + ((i >> 3) & 7), z + (i & 7)};
+                    double dx = c[0] - 63.5, dy = c[1] - 63.5, dz = c[2] - 63.5;
+                    int corner = (c[0] == 0 && c[1] == 0 && c[2] == 0) || (c[0] == 127 && c[1] == 127 && c[2] == 127);
+                    int on = full || corner || dx * dx + dy * dy + dz * dz <= 24.7 * 24.7;
+                    v[i] = (((c[0] + c[1] + c[2]) & 1) ? 1.4f : 0.2f) * (1.0f + (float)((c[0] * 7 + c[1] * 13 + c[2] * 5) % 64) / 256.0f);
+                    if (on)
+                        mask[i >> 6] |= 1ull << (i & 63);
+                }
+                int o[3] = {x, y, z};
+                if (murk_sparse_leaf(b, o, v, mask, err, sizeof err)) {
+                    murk_sparse_abort(b);
+                    fail_msg("%s", err);
+                }
+            }
+    return finish(b, map, hold);
+}
+
+/* Same box, extremes and voxels; the number of lookups (compare_eval) and bound-grid cells that differ. */
+static long compare_forms(const murk_field *s, const murk_field *d, uint64_t seed)
+{
+    int rs[3], rd[3];
+    murk_field_grid(s, rs, NULL);
+    murk_field_grid(d, rd, NULL);
+    assert_memory_equal(rs, rd, sizeof rs);
+    murk_vec3 l1, h1, l2, h2;
+    murk_field_bounds(s, &l1, &h1, NULL);
+    murk_field_bounds(d, &l2, &h2, NULL);
+    assert_memory_equal(&l1, &l2, sizeof l1);
+    assert_memory_equal(&h1, &h2, sizeof h1);
+    assert_true(same_float(murk_field_max(s), murk_field_max(d)) && same_float(murk_field_min(s), murk_field_min(d)));
+    long voxels_bad = 0;
+    for (int z = 0; z < rs[2]; z++)
+        for (int y = 0; y < rs[1]; y++)
+            for (int x = 0; x < rs[0]; x++)
+                voxels_bad += !same_float(murk_field_voxel(s, x, y, z), murk_field_voxel(d, x, y, z));
+    assert_int_equal(voxels_bad, 0);
+    return compare_eval(s, d, seed, 100000) + compare_bounds(s, d);
+}
+
+/* sparse.c's rule: a grid is held dense when its dense form (4 bytes a voxel of its box) is at most 1/16 larger
+ * than its sparse form. The fully active checker is (its dense form, with the box's border of zeros, is a few
+ * KiB larger than its bricks and nodes: held dense only thanks to the 1/16), and gives bitwise the lookups, voxels
+ * and bound grids of the same grid held sparse, with an axis-aligned map and a rotated one; the ball of 3 % stays
+ * sparse, and equals its dense form (forced) the same way. Must-fail: one voxel of the held-dense checker 1 ulp
+ * higher is seen. */
+static void test_held_dense(void **state)
+{
+    (void)state;
+    double c = cos(0.5), sn = sin(0.5);
+    const double rotated[12] = {0.01 * c, -0.01 * sn, 0, 0.1, 0.01 * sn, 0.01 * c, 0, -0.2, 0, 0, 0.008, 0.3};
+    for (int k = 0; k < 3; k++) {
+        int full = k < 2;
+        const double *map = k == 1 ? rotated : MAP_SCALED;
+        murk_field *a = build_form(full, map, MURK_HOLD_SMALLER), *sp = build_form(full, map, MURK_HOLD_SPARSE);
+        murk_field *other = full ? a : build_form(0, map, MURK_HOLD_DENSE);
+        murk_field_info fa, fs, fo;
+        murk_field_describe(a, &fa);
+        murk_field_describe(sp, &fs);
+        murk_field_describe(other, &fo);
+        int res[3];
+        const float *data;
+        murk_field_grid(a, res, &data);
+        uint64_t dense = 4ull * (uint64_t)res[0] * (uint64_t)res[1] * (uint64_t)res[2];
+        printf("%s%s: box %dx%dx%d, %llu active voxels; dense form %llu bytes, sparse form %zu bytes (%.4fx): held %s, "
+               "%zu bytes\n", full ? "checker, every voxel active" : "ball, 3 % active", k == 1 ? ", rotated" : "",
+               res[0], res[1], res[2], (unsigned long long)fs.active, (unsigned long long)dense, fs.sparse_bytes,
+               (double)dense / (double)fs.sparse_bytes, fa.held_dense ? "dense" : "sparse", fa.bytes);
+        assert_true(fs.sparse && !fs.held_dense && fo.held_dense && !fo.sparse);
+        assert_int_equal(fa.held_dense, full);
+        assert_int_equal(fa.sparse, !full);
+        assert_true(full ? data != NULL : data == NULL);
+        assert_int_equal(fa.held_dense, dense <= fs.sparse_bytes + fs.sparse_bytes / 16);
+        assert_int_equal(fo.sparse_bytes, fs.sparse_bytes);
+        assert_int_equal(fo.active, fs.active);
+        assert_int_equal(fo.transformed, k == 1);
+        assert_int_equal(fo.bytes, sizeof(murk_field) + dense);
+        long bad = compare_forms(sp, other, 40 + (uint64_t)k);
+        printf("  against it held sparse: %ld of 100000 lookups and bound-grid cells differ\n", bad);
+        assert_int_equal(bad, 0);
+        if (k == 0) { /* must-fail: a voxel in the middle of the held-dense grid 1 ulp higher */
+            murk_field_grid(a, res, &data);
+            float *mut = (float *)(uintptr_t)data;
+            size_t at = ((size_t)64 * res[1] + 64) * res[0] + 64;
+            mut[at] = nextafterf(mut[at], INFINITY);
+            murk_vec3 lo, hi;
+            murk_field_bounds(a, &lo, &hi, NULL);
+            long seen = 0;
+            for (int j = 0; j < 64; j++) {
+                float f[3] = {(64.5f + 0.1f * (float)(j % 4)) / (float)res[0], (64.5f - 0.1f * (float)(j / 4 % 4)) / (float)res[1],
+                              (64.5f + 0.05f * (float)(j / 16)) / (float)res[2]};
+                murk_vec3 q = murk_v3(lo.x + (hi.x - lo.x) * f[0], lo.y + (hi.y - lo.y) * f[1], lo.z + (hi.z - lo.z) * f[2]);
+                seen += !same_float(murk_field_eval(a, q), murk_field_eval(sp, q));
+            }
+            printf("  must-fail: one voxel of the held-dense grid 1 ulp higher: %ld of 64 lookups around it differ\n", seen);
+            assert_true(seen > 0);
+        }
+        if (other != a)
+            murk_field_free(other);
+        murk_field_free(a);
+        murk_field_free(sp);
+    }
 }
 
 /* A builder fed one bad thing: the error must contain needle. */
@@ -514,6 +648,23 @@ static void test_vdb_grids(void **state)
     fclose(out);
     murk_field_free(load_vdb(one, "density")); /* the file as written loads */
     expect_vdb_error(kids, "density", "truncated: grid 'density' root children at byte");
+    /* the grid's delayed-load metadata claiming 2^32 - 1 leaves: libopenvdb sizes its arrays by the claim
+     * (4 GB; 36 GB for the compressed sizes) before it reads them */
+    const char *dl = tmp_path("delayed_load.vdb");
+    in = fopen(one, "rb"), out = fopen(dl, "wb");
+    assert_true(in && out);
+    n = fread(whole, 1, sizeof whole, in);
+    static const char tag[] = "__delayedload";
+    char *at_tag = NULL;
+    for (size_t i = 0; !at_tag && i + sizeof tag <= n; i++)
+        if (memcmp(whole + i, tag, sizeof tag - 1) == 0)
+            at_tag = whole + i;
+    assert_non_null(at_tag);
+    memset(at_tag + sizeof tag - 1 + 4, 0xff, 4); /* after the type name, the value's byte count, then the count */
+    assert_true(fwrite(whole, 1, n, out) == n);
+    fclose(in);
+    fclose(out);
+    expect_vdb_error(dl, "density", "file_delayed_load claims 4294967295 leaves");
     murk_rng rng;
     murk_rng_seed(&rng, 3, 4, 5);
     for (size_t i = 0; i < sizeof buf; i++)
@@ -795,7 +946,7 @@ static void info_memory(const char *vdb, double *peak, double *grid, double *act
     const char *args[] = {"info", scene, NULL};
     if (run_murk_argv(&out, args) != 0)
         fail_msg("murk info failed:\n%s", out);
-    const char *p = strstr(out, "(VmHWM) "), *g = strstr(out, "\n  grid     smoke"), *a = g ? strstr(g, "active voxels in") : NULL;
+    const char *p = strstr(out, "(VmHWM) "), *g = strstr(out, "\n  grid     smoke"), *a = g ? strstr(g, " active voxels") : NULL;
     assert_true(p && g && a);
     double v;
     char unit[8];
@@ -1099,6 +1250,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sparse_equals_dense),
         cmocka_unit_test(test_inactive_and_tiles),
+        cmocka_unit_test(test_held_dense),
         cmocka_unit_test(test_builder_errors),
         cmocka_unit_test(test_vdb_grids),
         cmocka_unit_test(test_vdb_closed_form),

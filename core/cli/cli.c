@@ -90,9 +90,11 @@ static const struct command_help {
     {"check",
      "usage: murk check [--seed S] [--quick] [--set KEY=VALUE]... PLUGIN...\n"
      "Runs murk's statistical tests on plugins (by name or .so path): chi-square, reciprocity and furnace for\n"
-     "materials; closed-form transmittance, cross-tracker agreement and heavy tails for trackers; a furnace for\n"
-     "integrators. Each plugin runs with its defaults, every range at 25 % and 75 %, and each parameter alone at\n"
-     "both ends of its range and at every enum and bool value; each in a process of its own (a crash is a FAIL).\n"
+     "materials; closed-form transmittance, cross-tracker agreement and heavy tails for trackers; closed-form\n"
+     "means, signs and heavy tails for transmittance estimators; chi-square, normalisation, reciprocity and\n"
+     "mean cosine for phase functions; a furnace for integrators. Each plugin runs with its defaults, every\n"
+     "range at 25 % and 75 %, and each parameter alone at both ends of its range and at every enum and bool\n"
+     "value (at most 48 sets: a WARN says what was left out); each in a process of its own (a crash is a FAIL).\n"
      "  --seed S          the random seed (default fixed)\n"
      "  --quick           fewer samples\n"
      "  --set KEY=VALUE   check one plugin at these parameter values (repeatable) instead of the sweep\n"},

@@ -68,6 +68,8 @@ static void put_block(const murk_plugin *p, const murk_ynode *block, const char 
 static void put_vec(const char *label, murk_vec3 v) { printf("%s [%g, %g, %g]", label, v.x, v.y, v.z); }
 static void put_rgb(const char *label, murk_rgb c) { printf("%s [%g, %g, %g]", label, c.c[0], c.c[1], c.c[2]); }
 
+static const char *bytes_text(char *buf, size_t n, uint64_t b);
+
 static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
 {
     /* the keys the core reads (shown below), not the tracker's own: "type", the special keys, the schema */
@@ -106,6 +108,7 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
         put_node(dn, NULL, 0);
     else
         printf("{ constant: 1 } (default)");
+    char b1[32], b2[32];
     if (fi.grid)
         printf(": %s grid %dx%dx%d voxels over [%g, %g, %g]-[%g, %g, %g]%s, max %g", fi.sparse ? "sparse" : "dense",
                res[0], res[1], res[2], lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
@@ -113,7 +116,13 @@ static void info_medium(const murk_named_medium *nm, const murk_ynode *block)
     else
         printf(": constant %g, everywhere", murk_field_max(f));
     if (fi.sparse)
-        printf("\n                   %llu active voxels in %zu bricks of 8^3", (unsigned long long)fi.active, fi.bricks);
+        printf("\n                   %llu active voxels in %zu bricks of 8^3, %s held (dense it would be %s)",
+               (unsigned long long)fi.active, fi.bricks, bytes_text(b1, sizeof b1, fi.bytes),
+               bytes_text(b2, sizeof b2, (uint64_t)res[0] * (uint64_t)res[1] * (uint64_t)res[2] * sizeof(float)));
+    else if (fi.held_dense) /* sparse.c's rule: held dense when that is no larger */
+        printf("\n                   %llu active voxels, held dense: %s (sparse it would be %s)",
+               (unsigned long long)fi.active, bytes_text(b1, sizeof b1, fi.bytes),
+               bytes_text(b2, sizeof b2, fi.sparse_bytes));
     float st = murk_rgb_max(murk_rgb_add(md->sigma_a, md->sigma_s));
     printf("\n    majorant       %dx%dx%d cells, majorant_factor %g; largest majorant %g (extinction %g x density "
            "%g x factor)\n", g->res[0], g->res[1], g->res[2], factor,
@@ -242,7 +251,7 @@ void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
     murk_scene_memory(s, it, n);
     static const char *const kinds[] = {"grid", "mesh", "texture", "embree"};
     static const char *const plural[] = {"grids", "meshes", "textures", "Embree"};
-    uint64_t total[4] = {0}, all = 0, dense = 0;
+    uint64_t total[4] = {0}, all = 0, dense = 0, held = 0;
     char b1[32], b2[32];
     if (detail)
         fprintf(f, "memory (bytes held as allocated; README, Limits)\n");
@@ -252,6 +261,7 @@ void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
                 total[k] += it[i].bytes;
         all += it[i].bytes;
         dense += it[i].dense_bytes;
+        held += it[i].sparse_bytes != 0;
         if (detail)
             fprintf(f, "  %-8s %-24s %10s  %s\n", it[i].kind, murk_cli_q(it[i].name), bytes_text(b1, sizeof b1, it[i].bytes),
                     murk_cli_q(it[i].detail));
@@ -265,8 +275,15 @@ void murk_cli_memory_print(FILE *f, const murk_scene *s, int detail)
         fprintf(f, "memory:");
         for (int k = 0; k < 4; k++) {
             fprintf(f, "%s %s %s", k ? "," : "", plural[k], bytes_text(b1, sizeof b1, total[k]));
-            if (k == 0 && dense) /* sparse grids: what their voxels would take dense */
-                fprintf(f, " (sparse; dense %s)", bytes_text(b2, sizeof b2, dense));
+            if (k == 0 && (dense || held)) {
+                fputs(" (", f);
+                if (dense) /* sparse grids: what their voxels would take dense */
+                    fprintf(f, "sparse; dense %s", bytes_text(b2, sizeof b2, dense));
+                if (held) /* .vdb / .nvdb grids held dense by sparse.c's rule: counted dense above */
+                    fprintf(f, "%s%llu sparse grid%s held dense, at most 1/16 larger", dense ? "; " : "",
+                            (unsigned long long)held, held > 1 ? "s" : "");
+                fputc(')', f);
+            }
         }
         if (peak >= 0)
             fprintf(f, "; peak resident %s", bytes_text(b2, sizeof b2, (uint64_t)peak * 1024));

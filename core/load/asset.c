@@ -56,8 +56,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #ifdef MURK_HAVE_ASSIMP
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -115,6 +117,19 @@ static void normal_map(const xform *x, double n[9])
     n[0] = m[5] * m[10] - m[6] * m[9], n[1] = m[6] * m[8] - m[4] * m[10], n[2] = m[4] * m[9] - m[5] * m[8];
     n[3] = m[2] * m[9] - m[1] * m[10], n[4] = m[0] * m[10] - m[2] * m[8], n[5] = m[1] * m[8] - m[0] * m[9];
     n[6] = m[1] * m[6] - m[2] * m[5], n[7] = m[2] * m[4] - m[0] * m[6], n[8] = m[0] * m[5] - m[1] * m[4];
+}
+
+/* Adds path (taken) to the scene's asset inputs, the files beside a scene's own that its content hash
+ * covers (load.c, murk_scene_hash), unless it is there already. */
+static void note_input(murk_scene *s, char *path)
+{
+    for (size_t i = 0; i < s->nasset_inputs; i++)
+        if (!strcmp(s->asset_inputs[i], path)) {
+            free(path);
+            return;
+        }
+    s->asset_inputs = murk_xrealloc(s->asset_inputs, (s->nasset_inputs + 1) * sizeof *s->asset_inputs);
+    s->asset_inputs[s->nasset_inputs++] = path;
 }
 
 typedef struct asset_ctx {
@@ -295,9 +310,7 @@ static int file_texture(asset_ctx *a, const struct aiMaterial *m, enum aiTexture
             free(tp);
             return ERR(a->file, "%s: material %s: %s '%s': %s", a->name, mlabel, what, shown, ierr);
         }
-        murk_scene *s = a->s; /* the checkpoint's content hash covers it (load.c) */
-        s->asset_inputs = murk_xrealloc(s->asset_inputs, (s->nasset_inputs + 1) * sizeof *s->asset_inputs);
-        s->asset_inputs[s->nasset_inputs++] = tp;
+        note_input(a->s, tp); /* the checkpoint's content hash covers it (load.c) */
         snprintf(name, sizeof name, "%s", shown);
     }
     *out = murk_scene_keep_texture(a->s, murk_texture_from_image(&img, name));
@@ -789,69 +802,133 @@ static int ply_header_ends(const char *path)
     free(b);
     return found;
 }
-#endif
 
-/* ---- the block ------------------------------------------------------------------------------------------ */
+/* ---- the files Assimp reads ------------------------------------------------------------------------------ */
 
-/* The block's own keys (file, transform, material, emission, interior, exterior) into a. */
-int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, size_t *cap, const char *camera,
-                    murk_asset_camera *cam, char *err, size_t errlen)
+/* Assimp's file system, as its default one (stdio), except that every regular file it opens beside the asset
+ * (a .gltf's .bin buffers, an OBJ's .mtl, ...) is noted as an asset input: a checkpoint of the scene is then
+ * refused once one of them changed, as it is for the asset file itself (load.c, the content hash). */
+typedef struct io_ctx {
+    murk_scene *s;
+    const char *path; /* the asset file, hashed as the scene names it */
+} io_ctx;
+
+static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
 {
-    static const char *const keys[] = {"type", "file", "transform", "material", "emission", "interior", "exterior",
-                                       "lights", "light_scale"};
-    if (murk_ycheck_keys(n, "asset", keys, sizeof keys / sizeof keys[0], err, errlen))
-        return -1;
-    const murk_ynode *f = murk_yrequire(n, "file", "asset shape", err, errlen), *c;
-    const char *file = NULL;
-    if (!f || murk_yread_string(f, "asset.file", &file, err, errlen))
-        return -1;
-    static const char *const exts[] = {".gltf", ".glb", ".ply", ".fbx", ".obj"};
-    int known = 0;
-    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
-        known |= ends_with(file, exts[i]);
-    if (!known)
-        return ERR(f, "asset: '%s' is not a file murk reads as an asset (.gltf, .glb, .ply, .fbx, .obj)", file);
-#ifndef MURK_HAVE_ASSIMP
-    (void)s, (void)host, (void)cap, (void)camera, (void)cam, (void)c;
-    return ERR(f, "asset: murk was built without Assimp, so it cannot read %s (install libassimp-dev and rebuild: "
-               "tools/build.sh, or meson configure -Dassimp=enabled)", file);
-#else
-    asset_ctx a = {.s = s, .host = host, .n = n, .file = f, .name = file, .cap = cap};
+    return fread(buf, size, count, (FILE *)(void *)f->UserData);
+}
+
+static size_t io_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0;
+}
+
+static size_t io_tell(struct aiFile *f)
+{
+    long t = ftell((FILE *)(void *)f->UserData);
+    return t < 0 ? 0 : (size_t)t;
+}
+
+static size_t io_size(struct aiFile *f)
+{
+    struct stat st;
+    return fstat(fileno((FILE *)(void *)f->UserData), &st) == 0 && st.st_size > 0 ? (size_t)st.st_size : 0;
+}
+
+static enum aiReturn io_seek(struct aiFile *f, size_t off, enum aiOrigin origin)
+{
+    int whence = origin == aiOrigin_CUR ? SEEK_CUR : origin == aiOrigin_END ? SEEK_END : SEEK_SET;
+    if (origin != aiOrigin_SET && origin != aiOrigin_CUR && origin != aiOrigin_END)
+        return aiReturn_FAILURE;
+    return fseek((FILE *)(void *)f->UserData, (long)off, whence) == 0 ? aiReturn_SUCCESS : aiReturn_FAILURE;
+}
+
+static void io_flush(struct aiFile *f) { fflush((FILE *)(void *)f->UserData); }
+
+static struct aiFile *io_open(struct aiFileIO *io, const char *name, const char *mode)
+{
+    io_ctx *c = (io_ctx *)(void *)io->UserData;
+    if (!name || !mode)
+        return NULL;
+    FILE *fp = fopen(name, mode);
+    if (!fp)
+        return NULL;
+    struct aiFile *f = calloc(1, sizeof *f);
+    if (!f) {
+        fclose(fp);
+        return NULL;
+    }
+    f->ReadProc = io_read;
+    f->WriteProc = io_write;
+    f->TellProc = io_tell;
+    f->FileSizeProc = io_size;
+    f->SeekProc = io_seek;
+    f->FlushProc = io_flush;
+    f->UserData = (aiUserData)(void *)fp;
+    struct stat st;
+    if (strcmp(name, c->path) != 0 && fstat(fileno(fp), &st) == 0 && S_ISREG(st.st_mode))
+        note_input(c->s, murk_strdup(name));
+    return f;
+}
+
+static void io_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (!f)
+        return;
+    fclose((FILE *)(void *)f->UserData);
+    free(f);
+}
+
+/* The block's keys beside file (transform, lights, light_scale, material, interior, exterior, emission) into a,
+ * *lights and *light_scale. */
+static int read_keys(asset_ctx *a, int *lights, double *light_scale, char *err, size_t errlen)
+{
+    murk_scene *s = a->s;
+    const murk_ynode *n = a->n, *c;
     float m[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
     const murk_ynode *t = murk_ymap_get(n, "transform");
     if (t && murk_read_transform(t, m, err, errlen))
         return -1;
     for (int i = 0; i < 12; i++)
-        a.user.m[i] = m[i];
-    int lights = 1;
-    double light_scale = 1.0;
-    if ((c = murk_ymap_get(n, "lights")) && murk_yread_bool(c, "asset.lights", &lights, err, errlen))
+        a->user.m[i] = m[i];
+    if ((c = murk_ymap_get(n, "lights")) && murk_yread_bool(c, "asset.lights", lights, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "light_scale")) && murk_yread_range(c, "asset.light_scale", 0, 1e30, &light_scale, err, errlen))
+    if ((c = murk_ymap_get(n, "light_scale")) && murk_yread_range(c, "asset.light_scale", 0, 1e30, light_scale, err, errlen))
         return -1;
     if ((c = murk_ymap_get(n, "material"))) {
         if (c->kind == MURK_Y_SCALAR && !strcmp(c->str, "from_file"))
-            a.from_file = 1;
-        else if (murk_load_lookup_material(s, c, &a.material, err, errlen))
+            a->from_file = 1;
+        else if (murk_load_lookup_material(s, c, &a->material, err, errlen))
             return -1;
     }
-    if ((c = murk_ymap_get(n, "interior")) && murk_load_lookup_medium(s, c, &a.interior, err, errlen))
+    if ((c = murk_ymap_get(n, "interior")) && murk_load_lookup_medium(s, c, &a->interior, err, errlen))
         return -1;
-    if ((c = murk_ymap_get(n, "exterior")) && murk_load_lookup_medium(s, c, &a.exterior, err, errlen))
+    if ((c = murk_ymap_get(n, "exterior")) && murk_load_lookup_medium(s, c, &a->exterior, err, errlen))
         return -1;
     if ((c = murk_ymap_get(n, "emission"))) {
         double e[3];
         if (murk_yread_rgb(c, "emission", 0, 1e30, e, err, errlen))
             return -1;
-        a.emission = murk_rgb3((float)e[0], (float)e[1], (float)e[2]);
-        a.have_emission = 1;
+        a->emission = murk_rgb3((float)e[0], (float)e[1], (float)e[2]);
+        a->have_emission = 1;
     }
-    if (!a.material && !a.from_file && !murk_ymap_get(n, "interior"))
+    if (!a->material && !a->from_file && !murk_ymap_get(n, "interior"))
         return ERR(n, "asset has no material (give one, material: from_file, or interior: MEDIUM for an index-matched "
                    "medium boundary)");
-    if (!a.material && !a.from_file && !murk_rgb_is_black(a.emission))
+    if (!a->material && !a->from_file && !murk_rgb_is_black(a->emission))
         return ERR(murk_ymap_get(n, "emission"), "an emissive asset needs a material");
-    char *path = murk_path_relative_to(s->doc.file, file), ferr[768];
+    return 0;
+}
+
+/* The file at path (a->name as the block gives it) through Assimp into a->ai, a->path = path; first what
+ * Debian's Assimp 5.2 does not survive is refused. On failure path and a->strength are freed. */
+static int import_file(asset_ctx *a, char *path, char *err, size_t errlen)
+{
+    const murk_ynode *f = a->file;
+    const char *file = a->name;
+    char ferr[768];
     uint64_t size;
     FILE *fp = murk_file_open_regular(path, &size, ferr, sizeof ferr);
     if (!fp) {
@@ -859,15 +936,15 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
         return ERR(f, "asset: %s", ferr);
     }
     fclose(fp);
-    if (a.from_file && (ends_with(file, ".gltf") || ends_with(file, ".glb"))) {
+    if (a->from_file && (ends_with(file, ".gltf") || ends_with(file, ".glb"))) {
         unsigned char *bytes = murk_file_read_all(path, &size, ferr, sizeof ferr);
         if (bytes)
-            a.strength = emissive_strengths(bytes, (size_t)size, &a.nstrength);
+            a->strength = emissive_strengths(bytes, (size_t)size, &a->nstrength);
         free(bytes);
     }
     if (ends_with(file, ".ply") && !ply_header_ends(path)) {
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: its PLY header has no 'end_header' line (Assimp 5.2 would read on without end)", file);
     }
     struct aiPropertyStore *props = aiCreatePropertyStore();
@@ -875,8 +952,14 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
     /* read first without post-processing, to refuse a face without vertices (a PLY face list of 0), on which
      * Debian's Assimp 5.2 aborts in its Triangulate step (an ai_assert; found by tests/fuzz, seed ply_empty_face);
      * then read again with the steps. Not aiApplyPostProcessing on the first scene: when its validation fails
-     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release). */
-    const struct aiScene *probe = aiImportFileExWithProperties(path, 0, NULL, props);
+     * it releases the scene twice (a crash fuzz_asset found; seed apply_postprocess_release), as it does when
+     * any later step fails (SortByPType removing every mesh of a file of points or lines); and validating in the
+     * first read would run before Assimp's preprocessing sets the primitive types it checks faces by, and
+     * report a file's other faults before its empty face. So the second read stays; what it costs (the first
+     * two imports of a process are the slow ones) is in docs/results.md, "Assets read twice". */
+    io_ctx ioc = {a->s, path};
+    struct aiFileIO io = {io_open, io_close, (aiUserData)(void *)&ioc};
+    const struct aiScene *probe = aiImportFileExWithProperties(path, 0, &io, props);
     char bad[300] = "";
     for (unsigned m = 0; probe && m < probe->mNumMeshes && !bad[0]; m++)
         for (unsigned k = 0; probe->mMeshes[m] && probe->mMeshes[m]->mFaces && k < probe->mMeshes[m]->mNumFaces && !bad[0]; k++)
@@ -887,19 +970,54 @@ int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, s
     if (bad[0]) {
         aiReleasePropertyStore(props);
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: %s", file, bad);
     }
-    a.ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
-                                                aiProcess_ValidateDataStructure, NULL, props) : NULL;
+    a->ai = probe ? aiImportFileExWithProperties(path, aiProcess_Triangulate | aiProcess_SortByPType |
+                                                 aiProcess_ValidateDataStructure, &io, props) : NULL;
     aiReleasePropertyStore(props);
-    a.path = path;
-    if (!a.ai) {
+    a->path = path;
+    if (!a->ai) {
         char msg[512];
         free(path);
-        free(a.strength);
+        free(a->strength);
         return ERR(f, "asset: %s: Assimp cannot read it: %s", file, murk_printable(msg, sizeof msg, aiGetErrorString()));
     }
+    return 0;
+}
+#endif
+
+/* ---- the block ------------------------------------------------------------------------------------------ */
+
+/* An `asset` shape block: its file read through Assimp into shapes, and its lights and camera. */
+int murk_load_asset(murk_scene *s, const murk_host *host, const murk_ynode *n, size_t *cap, const char *camera,
+                    murk_asset_camera *cam, char *err, size_t errlen)
+{
+    static const char *const keys[] = {"type", "file", "transform", "material", "emission", "interior", "exterior",
+                                       "lights", "light_scale"};
+    if (murk_ycheck_keys(n, "asset", keys, sizeof keys / sizeof keys[0], err, errlen))
+        return -1;
+    const murk_ynode *f = murk_yrequire(n, "file", "asset shape", err, errlen);
+    const char *file = NULL;
+    if (!f || murk_yread_string(f, "asset.file", &file, err, errlen))
+        return -1;
+    static const char *const exts[] = {".gltf", ".glb", ".ply", ".fbx", ".obj"};
+    int known = 0;
+    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++)
+        known |= ends_with(file, exts[i]);
+    if (!known)
+        return ERR(f, "asset: '%s' is not a file murk reads as an asset (.gltf, .glb, .ply, .fbx, .obj)", file);
+#ifndef MURK_HAVE_ASSIMP
+    (void)s, (void)host, (void)cap, (void)camera, (void)cam;
+    return ERR(f, "asset: murk was built without Assimp, so it cannot read %s (install libassimp-dev and rebuild: "
+               "tools/build.sh, or meson configure -Dassimp=enabled)", file);
+#else
+    asset_ctx a = {.s = s, .host = host, .n = n, .file = f, .name = file, .cap = cap};
+    int lights = 1;
+    double light_scale = 1.0;
+    if (read_keys(&a, &lights, &light_scale, err, errlen) ||
+        import_file(&a, murk_path_relative_to(s->doc.file, file), err, errlen))
+        return -1;
     int rc = 0;
     a.made = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made);
     a.made_emission = murk_xmalloc((a.ai->mNumMaterials ? a.ai->mNumMaterials : 1) * sizeof *a.made_emission);

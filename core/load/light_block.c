@@ -140,7 +140,9 @@ static int load_sky(const light_ctx *c, char *err, size_t errlen)
     const murk_ynode *k;
     if (get_vec3(c, "sun_direction", 1, 1, &dir, err, errlen) < 0 || get_num(c, "turbidity", 1.7, 10, 3, &T, err, errlen))
         return -1;
-    if ((k = murk_ymap_get(c->n, "sun")) && murk_yread_bool(k, "sun", &sun, err, errlen))
+    char what[128];
+    snprintf(what, sizeof what, "%s: sun", c->who);
+    if ((k = murk_ymap_get(c->n, "sun")) && murk_yread_bool(k, what, &sun, err, errlen))
         return -1;
     char why[512];
     return added(c, murk_lights_add_sky(c->s, dir, T, sun, why, sizeof why), "sun_direction", why, err, errlen);

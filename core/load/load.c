@@ -700,7 +700,7 @@ MURK_API uint64_t murk_scene_hash(const murk_scene *s, char *err, size_t errlen)
                 return 0;
     if (hash_textures(s, root, &h, err, errlen))
         return 0;
-    for (size_t i = 0; i < s->nasset_inputs; i++) { /* assets' textures, by their paths */
+    for (size_t i = 0; i < s->nasset_inputs; i++) { /* assets' buffers and textures, by their paths */
         uint64_t fh = murk_file_hash(s->asset_inputs[i], err, errlen);
         h = murk_fnv1a(h, s->asset_inputs[i], strlen(s->asset_inputs[i]) + 1);
         h = murk_fnv1a(h, &fh, sizeof fh);

@@ -55,6 +55,7 @@ typedef struct murk_mem_item {
     char detail[160];   /* e.g. "sparse, 32221669 active voxels in 68051 bricks" */
     uint64_t bytes;
     uint64_t dense_bytes; /* a sparse grid: what its voxels would take held dense (4 bytes each); else 0 */
+    uint64_t sparse_bytes; /* a sparse grid held dense (its dense form no larger): what its sparse form held */
 } murk_mem_item;
 /* Fills items[0..cap) and returns how many there are (it may exceed cap: call again with more room). */
 size_t murk_scene_memory(const murk_scene *s, murk_mem_item *items, size_t cap);

@@ -41,7 +41,12 @@ static void grid_item(const murk_named_medium *nm, murk_mem_item *it)
                  "bound grid %zu cells", res[0], res[1], res[2], (double)it->dense_bytes / 1048576.0,
                  (unsigned long long)fi.active, fi.bricks, cells);
     }
-    else if (fi.grid)
+    else if (fi.held_dense) {
+        it->sparse_bytes = fi.sparse_bytes;
+        snprintf(it->detail, sizeof it->detail, "dense %dx%dx%d, a sparse grid held dense (sparse: %.1f MiB), %llu "
+                 "active voxels; bound grid %zu cells", res[0], res[1], res[2], (double)fi.sparse_bytes / 1048576.0,
+                 (unsigned long long)fi.active, cells);
+    } else if (fi.grid)
         snprintf(it->detail, sizeof it->detail, "dense %dx%dx%d; bound grid %zu cells", res[0], res[1], res[2], cells);
     else
         snprintf(it->detail, sizeof it->detail, "constant");

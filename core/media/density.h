@@ -93,11 +93,14 @@ float murk_field_voxel(const murk_field *f, int x, int y, int z);
 /* What a field is and holds, for `murk info` and the render summary. */
 typedef struct murk_field_info {
     int sparse;            /* 1: bricks of active voxels (.vdb, .nvdb); 0: dense grid or constant */
+    int held_dense;        /* 1: a sparse grid (.vdb, .nvdb) held dense, its dense form being no larger than
+                              its sparse form (sparse.c, murk_sparse_end); sparse is 0 then */
     int grid;              /* 1: a grid (dense or sparse); 0: a constant */
     int transformed;       /* 1: a map that rotates, shears or mirrors (looked up in index space) */
-    uint64_t active;       /* sparse: active voxels of the source grid */
+    uint64_t active;       /* sparse or held_dense: active voxels of the source grid */
     size_t bricks;         /* sparse: distinct 8^3 bricks (shared constant bricks once) */
     size_t bytes;          /* memory held: the voxels (dense), or bricks, nodes and tables (sparse) */
+    size_t sparse_bytes;   /* sparse: its bricks, nodes and tables; held_dense: what they held before */
 } murk_field_info;
 void murk_field_describe(const murk_field *f, murk_field_info *info);
 void murk_field_free(murk_field *f);

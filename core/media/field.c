@@ -255,14 +255,20 @@ MURK_API void murk_field_describe(const murk_field *f, murk_field_info *info)
     memset(info, 0, sizeof *info);
     info->grid = f->kind != FIELD_CONSTANT;
     info->sparse = f->kind == FIELD_SPARSE;
+    info->held_dense = f->from_sparse;
     info->transformed = f->affine;
     info->bytes = sizeof *f;
     if (f->kind == FIELD_GRID)
         info->bytes += (size_t)f->res[0] * (size_t)f->res[1] * (size_t)f->res[2] * sizeof *f->data;
+    if (f->from_sparse) {
+        info->active = f->active;
+        info->sparse_bytes = f->sparse_bytes;
+    }
     if (f->kind == FIELD_SPARSE) {
         info->active = f->sparse->active;
         info->bricks = f->sparse->nowned - 1; /* not the brick of zeros */
-        info->bytes += murk_sparse_bytes(f->sparse);
+        info->sparse_bytes = murk_sparse_bytes(f->sparse);
+        info->bytes += info->sparse_bytes;
     }
 }
 

@@ -51,6 +51,11 @@ struct murk_field {
     float scale[3];       /* res / (hi - lo): box to cell units */
     float *data;          /* FIELD_GRID */
     murk_sparse *sparse;  /* FIELD_SPARSE */
+    /* A FIELD_GRID built as a sparse grid (.vdb, .nvdb) and held dense by murk_sparse_end's rule: from_sparse
+     * is 1, active the source's active voxels, sparse_bytes what its sparse form held (murk_sparse_bytes). */
+    int from_sparse;
+    uint64_t active;
+    size_t sparse_bytes;
     float vmin, vmax;     /* voxel extremes */
     /* A grid whose index-to-world map rotates, shears or mirrors: lo/hi/scale are in its local space
      * (index space, shifted so that the box starts at -1/2), where the field is looked up and its bound
@@ -120,8 +125,23 @@ int murk_sparse_tile(murk_sparse_build *b, const int origin[3], long long dim, f
 /* The field, with the file's index-to-world map (row-major 3 x 4: world_r = m[4r..4r+2] . ijk + m[4r+3],
  * voxel ijk's value sitting at world(ijk)). An axis-aligned map with positive scales gives a world box;
  * any other invertible map a local box (field_impl.h, `affine`). NULL with err for a map that is not
- * finite or is singular, a box that float cannot hold, or out of memory. Frees b either way. */
+ * finite or is singular, a box that float cannot hold, or out of memory. Frees b either way.
+ * The form it is held in: sparse, unless its dense form (4 bytes for each voxel of its box) is at most
+ * 1/MURK_DENSE_SLACK larger than its sparse form (murk_sparse_bytes: bricks, nodes, tables) and its box within
+ * MURK_MAX_GRID_VOXELS, in which case it is held dense (FIELD_GRID, from_sparse): the same box, voxels and map,
+ * so every lookup gives the same value bit for bit, and a lookup costs a dense one, without the brick table a
+ * grid with few empty bricks pays for on every lookup held sparse (docs/results.md, "Sparse grids"). Why the
+ * slack: a grid with every brick present costs about 4 bytes a voxel both ways (a brick 2056 bytes for 512
+ * voxels, plus nodes; the dense box one voxel of zeros wider on each side), so "no larger" alone flips on a
+ * few KiB either way (the bench's fully active 128^3 checker is one: docs/results.md). So a grid held dense holds
+ * at most 17/16 of its sparse form's bytes and at most 4 x MURK_MAX_GRID_VOXELS bytes, as a sparse one; while
+ * it is copied the two forms are held together. */
+#define MURK_DENSE_SLACK 16
 murk_field *murk_sparse_end(murk_sparse_build *b, const double map[12], char *err, size_t errlen);
+/* murk_sparse_end with the form chosen: MURK_HOLD_SMALLER (murk_sparse_end's rule), or always sparse, or always
+ * dense (for tests and the bench, which compare the two forms of one grid). */
+enum { MURK_HOLD_SMALLER, MURK_HOLD_SPARSE, MURK_HOLD_DENSE };
+murk_field *murk_sparse_finish(murk_sparse_build *b, const double map[12], int hold, char *err, size_t errlen);
 void murk_sparse_abort(murk_sparse_build *b);
 
 /* Little-endian scalars of the grid file formats. */

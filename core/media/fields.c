@@ -50,7 +50,7 @@ static int check_max(const murk_field3 *f, const murk_ynode *n, const char *what
         murk_field_info fi;
         murk_field_describe(f->ch[k], &fi);
         return murk_yerr(err, errlen, n, "%s: value %g at voxel (%ld, %ld, %ld)%s%s is above %g", what, (double)v,
-                         x, y, z, fi.sparse ? " of the grid's box" : "",
+                         x, y, z, fi.sparse || fi.held_dense ? " of the grid's box" : "",
                          f->ch[1] != f->ch[0] ? (k == 0 ? " (red)" : k == 1 ? " (green)" : " (blue)") : "", hi);
     }
     return 0;

@@ -11,7 +11,13 @@
  * 4 x MURK_MAX_GRID_VOXELS bytes, the memory of the largest dense grid murk accepts; bricks are allocated
  * one by one at 514 floats, the size of an OpenVDB leaf buffer's allocation (2048 bytes, the same malloc
  * chunk), so that the shim can free each OpenVDB leaf as its brick is made and the allocator reuses it:
- * the peak while loading stays near one copy of the grid. */
+ * the peak while loading stays near one copy of the grid.
+ *
+ * The form a grid is held in (murk_sparse_end; field_impl.h states the rule): sparse, unless its dense form,
+ * 4 bytes for each voxel of its box, is at most 1/16 larger than its sparse form's bytes (murk_sparse_bytes),
+ * in which case it is copied into a dense grid with the same box and the bricks are freed: the same lookups bit
+ * for bit, and a dense grid's lookup cost (a grid with few empty bricks pays the brick table on every lookup
+ * and saves no memory for it, docs/results.md). */
 #include "media/field_impl.h"
 #include "util/error.h"
 #include "util/limit.h"
@@ -457,7 +463,41 @@ static int set_map(murk_sparse_build *b, const double m[12], char *err, size_t e
                                                              "representable in float");
 }
 
-murk_field *murk_sparse_end(murk_sparse_build *b, const double map[12], char *err, size_t errlen)
+/* The sparse field f held dense instead (FIELD_GRID, from_sparse): its box's voxels copied row by row, each
+ * brick looked up once per run of up to 8 voxels along x; the box, map, scale and extremes stay, so every
+ * lookup gives the same value bit for bit (field.c: one trilinear formula for both kinds). -1 with err
+ * (f unchanged) when out of memory or, forced dense, when the box has more voxels than a dense grid may. */
+static int hold_dense(murk_field *f, const char *path, char *err, size_t errlen)
+{
+    const murk_sparse *s = f->sparse;
+    uint64_t n = murk_voxel_count(f->res[0], f->res[1], f->res[2]);
+    if (n == 0)
+        return murk_err_file(err, errlen, path, "the grid's box (%d x %d x %d voxels) is too large to hold dense",
+                             f->res[0], f->res[1], f->res[2]);
+    float *d = malloc((size_t)n * sizeof *d);
+    if (!d)
+        return murk_err_file(err, errlen, path, "out of memory");
+    for (int z = 0; z < f->res[2]; z++)
+        for (int y = 0; y < f->res[1]; y++) {
+            float *row = d + ((size_t)z * (size_t)f->res[1] + (size_t)y) * (size_t)f->res[0];
+            for (int x = 0; x < f->res[0];) { /* a brick's voxels along x are 64 apart (field_impl.h) */
+                const float *br = murk_sparse_brick(s, x, y, z);
+                int o = murk_sparse_slot(s, x, y, z), run = 8 - ((x + s->off[0]) & 7);
+                for (int k = 0; k < run && x < f->res[0]; k++, x++)
+                    row[x] = br[o + (k << 6)];
+            }
+        }
+    f->active = s->active;
+    f->sparse_bytes = murk_sparse_bytes(s);
+    f->from_sparse = 1;
+    murk_sparse_free(f->sparse);
+    f->sparse = NULL;
+    f->data = d;
+    f->kind = FIELD_GRID;
+    return 0;
+}
+
+murk_field *murk_sparse_finish(murk_sparse_build *b, const double map[12], int hold, char *err, size_t errlen)
 {
     if (set_map(b, map, err, errlen)) {
         murk_sparse_abort(b);
@@ -468,9 +508,30 @@ murk_field *murk_sparse_end(murk_sparse_build *b, const double map[12], char *er
         f->scale[a] = (float)f->res[a] / (murk_v3_get(f->hi, a) - murk_v3_get(f->lo, a));
     int a0[3] = {0, 0, 0}, a1[3] = {f->res[0] - 1, f->res[1] - 1, f->res[2] - 1};
     murk_field_range(f, a0, a1, &f->vmax, &f->vmin);
+    /* the rule (field_impl.h): dense when 4 bytes a box voxel are at most the sparse form's bytes and 1/16 of
+     * them, i.e. res[0] res[1] <= (bytes + bytes / 16) / 4 / res[2] in integers (exactly that, without the
+     * product's overflow), and the box within the voxels a dense grid may have */
+    uint64_t sparse_bytes = murk_sparse_bytes(f->sparse);
+    int dense = hold == MURK_HOLD_DENSE ||
+                (hold == MURK_HOLD_SMALLER && (uint64_t)f->res[0] * (uint64_t)f->res[1] <=
+                 (sparse_bytes + sparse_bytes / MURK_DENSE_SLACK) / sizeof(float) / (uint64_t)f->res[2] &&
+                 murk_voxel_count(f->res[0], f->res[1], f->res[2]) != 0);
+    if (dense && hold_dense(f, b->path, err, errlen)) {
+        if (hold == MURK_HOLD_DENSE) {
+            murk_sparse_abort(b);
+            return NULL;
+        }
+        if (errlen) /* no memory for the dense copy: the grid stays sparse, as it is */
+            err[0] = 0;
+    }
     b->f = NULL;
     murk_sparse_abort(b);
     return f;
+}
+
+murk_field *murk_sparse_end(murk_sparse_build *b, const double map[12], char *err, size_t errlen)
+{
+    return murk_sparse_finish(b, map, MURK_HOLD_SMALLER, err, errlen);
 }
 
 /* ---- queries ------------------------------------------------------------------------------- */

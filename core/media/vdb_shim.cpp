@@ -126,7 +126,7 @@ public:
         if (!in)
             throw Failure{"cannot open it"};
         in.seekg(0, std::ios::end);
-        size = static_cast<uint64_t>(in.tellg());
+        size = file_size = static_cast<uint64_t>(in.tellg());
         in.seekg(0);
     }
     void check()
@@ -149,7 +149,7 @@ public:
 
 private:
     std::ifstream in;
-    uint64_t size = 0, pos = 0;
+    uint64_t size = 0, pos = 0, file_size = 0; /* size: the end of the part being walked */
     uint32_t version = 0;
 
     void need(uint64_t n, const std::string &what)
@@ -204,8 +204,54 @@ private:
                 if (type == f.type && bytes != f.bytes)
                     throw Failure{what + ": '" + printable(name) + "' is a " + type + " of " + std::to_string(bytes) +
                                   " bytes; a " + type + " has " + std::to_string(f.bytes)};
-            skip(bytes, what + ": a value");
+            if (type == "__delayedload" && bytes > 0)
+                delayed_load(what, bytes);
+            else
+                skip(bytes, what + ": a value");
         }
+    }
+    /* io::DelayedLoadMetadata::readValue, which sizes its arrays by the count it reads and the size a blosc
+     * header claims (found by fuzz_vdb: a 4 GB allocation): a leaf count no larger than the file could hold
+     * (a leaf takes at least its 64-byte mask), then a mask of a byte per leaf and the leaves' compressed
+     * sizes (8 bytes each; a length of 2^32 - 1 for none), each raw after a length 0 or a blosc block whose
+     * header states that length uncompressed and its own length compressed; all of it inside the value's
+     * byte count, since libopenvdb reads on from where the value ends for it, not where the count says. */
+    void delayed_load(const std::string &what, uint32_t bytes)
+    {
+        const std::string where = what + ": file_delayed_load";
+        need(bytes, where);
+        uint64_t limit = size, stop = pos + bytes;
+        size = stop;
+        uint64_t count = u32();
+        if (count > file_size / 64)
+            throw Failure{where + " claims " + std::to_string(count) + " leaves; the file holds at most " +
+                          std::to_string(file_size / 64)};
+        for (uint64_t elem : {1u, 8u}) {
+            uint32_t len = u32();
+            if (elem == 8 && len == UINT32_MAX)
+                break;
+            if (len == 0) {
+                skip(count * elem, where);
+                continue;
+            }
+            unsigned char h[16];
+            if (len < sizeof h)
+                throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes, shorter than its header"};
+            read(h, sizeof h, where);
+            uint32_t plain = le32(h + 4), packed = le32(h + 12);
+            if (plain != count * elem || packed != len)
+                throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes whose header says " +
+                              std::to_string(packed) + " bytes, " + std::to_string(plain) + " uncompressed, where " +
+                              std::to_string(count * elem) + " are needed"};
+            skip(len - sizeof h, where);
+        }
+        size = limit;
+        seek(stop);
+    }
+    static uint32_t le32(const unsigned char *b)
+    {
+        return static_cast<uint32_t>(b[0]) | static_cast<uint32_t>(b[1]) << 8 | static_cast<uint32_t>(b[2]) << 16 |
+               static_cast<uint32_t>(b[3]) << 24;
     }
     /* A grid descriptor and the head of its grid: metadata, transform, root counts. */
     void descriptor(uint32_t g)

@@ -105,7 +105,8 @@ struct murk_scene {
     murk_named_material **asset_materials;
     struct murk_ydoc **asset_docs;
     size_t nasset_materials;
-    char **asset_inputs; /* the files an asset loaded beside itself (its PNG textures), for the content hash */
+    char **asset_inputs; /* the files an asset loaded beside itself (the files Assimp opened, e.g. a .gltf's .bin
+                          * buffers or an OBJ's .mtl, and its PNG textures), for the content hash */
     size_t nasset_inputs;
     murk_named_medium *media;
     size_t nmedia;

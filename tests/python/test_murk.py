@@ -3,15 +3,19 @@ gives the murk command's EXR bit for bit; a scene error raises murk.SceneError w
 line, column; the --set it came from; a dict scene's key path) and the CLI's "did you mean"; input that is
 not a scene or not an image raises a Python exception, never a crash; Ctrl-C (a stop) and a progress
 callback end a render after whole passes; compare gives the CLI's figures; plugins lists the schemas;
-bench returns its rows; and the module imports and renders from a `meson install --destdir` prefix.
+bench returns its rows; a render leaves the GIL to other threads; the sweep example of docs/ runs; and the
+module imports and renders from a `meson install --destdir` prefix.
 Run by meson (tests 'python' and 'python_install'), which sets MURK_SOURCE_ROOT, MURK_EXE, MURK_BUILD_ROOT
 and the module's paths."""
 import copy
+import ctypes
 import json
 import math
 import os
 import subprocess
 import sys
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -166,6 +170,47 @@ def test_ctrl_c_stops_after_whole_passes():
     assert out.stdout.strip() == "interrupted True True True", out.stdout + out.stderr
 
 
+def _main_thread_share(work, bin_seconds=0.5):
+    """Runs work() on a thread of its own while this thread counts in which bins of bin_seconds (over
+    work's span) it got to run Python: the share of those bins, and the span in seconds."""
+    t = threading.Thread(target=work)
+    t0 = time.monotonic()
+    t.start()
+    bins = set()
+    while t.is_alive():
+        bins.add(int((time.monotonic() - t0) / bin_seconds))
+    span = time.monotonic() - t0
+    n = max(1, int(span / bin_seconds))
+    return len([b for b in bins if b < n]) / n, span
+
+
+def test_render_releases_the_gil():
+    """Another Python thread runs throughout a render of about 4 s (a bin of 0.5 s without it would mean
+    the render held the GIL for that long; bins that long keep a loaded machine's scheduling out of it).
+    Must fail: the same measure on calls that hold the GIL (libc's usleep through ctypes.PyDLL, two of
+    2 s) sees this thread stopped in most bins."""
+    r = []
+    share, span = _main_thread_share(lambda: r.append(murk.render(SMOKE, spp=1 << 20, time=4, threads=1,
+                                                                  set={"render.resolution": [32, 32]}, quiet=True)))
+    assert r and r[0].interrupted is False and span > 3.0
+    held = ctypes.PyDLL(None).usleep
+    held_share, _ = _main_thread_share(lambda: [held(2000000) for _ in range(2)])
+    print("main thread ran in %.0f %% of the bins during the render, %.0f %% during GIL-holding calls"
+          % (100 * share, 100 * held_share))
+    assert share >= 0.75, share
+    assert held_share <= 0.5, held_share  # the must-fail case: the measure sees a held GIL
+
+
+def test_sweep_example_runs(tmp_path):
+    """docs/python_sweep.py, the notebook-style example, in its --quick form: it renders, compares and plots."""
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "sweep.png"
+    run = subprocess.run([sys.executable, os.path.join(SRC, "docs", "python_sweep.py"), "--quick", str(out)], cwd=SRC,
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert out.stat().st_size > 1000 and run.stdout.count("relMSE") == 8
+
+
 def test_compare():
     ref = murk.render(BOX, spp=16)
     a = murk.render(BOX, spp=2, seed=9)
@@ -214,6 +259,14 @@ def test_bench_rows(tmp_path):
     assert (tmp_path / "b" / "bench.csv").exists() and (tmp_path / "b" / "report.html").exists()
     with pytest.raises(murk.SceneError, match=r"cornell_smoke.yaml:\d+:\d+: --vary media.smok.type: media has no 'smok'"):
         murk.bench(SMOKE, vary={"media.smok.type": ["delta"]}, spp=[1], repeat=2, ref_spp=4)
+
+
+def test_bench_frame(tmp_path):
+    """frame=True: the same rows as a pandas DataFrame (skipped where python3-pandas is not installed)."""
+    pandas = pytest.importorskip("pandas")
+    df = murk.bench(CORNELL, vary={"integrator.max_depth": [2, 4]}, set={"render.resolution": [8, 8]}, spp=[1],
+                    repeat=2, ref_spp=4, threads=1, frame=True)
+    assert isinstance(df, pandas.DataFrame) and len(df) == 4 and set(df["label"]) == {"max_depth=2", "max_depth=4"}
 
 
 @pytest.mark.install

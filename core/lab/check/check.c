@@ -6,8 +6,12 @@
  * search path, schema checks and create()), and its methods are called with the real host table.
  * All random numbers come from fixed seeds (--seed changes them): the same plugin gives the same figures.
  *
- * material   for the default parameters and two more sets (every numeric, non-texturable-only range at
- *            25% / 75%, RGB channels spread apart), at wo = 10, 45 and 80 degrees:
+ * Parameter sets (sweep.c): the defaults, two sets with every numeric range at 25 % / 75 % (RGB channels
+ * spread apart), and sweep points: each parameter alone at both ends of its range and at every enum and
+ * bool value (albedo 1, g = +-0.99); or only the values given with --set KEY=VALUE. `--quick` runs fewer
+ * samples at a sweep point.
+ *
+ * material   for each parameter set, at wo = 10, 45 and 80 degrees (--quick: a sweep point's chi2 at 45):
  *              chi2       sample() against pdf(): the sphere cut into 16 x 32 cells refined around the
  *                         mirror direction, expected counts from adaptive quadrature of pdf() over each
  *                         cell, one more cell for "no sample or a delta lobe"; fails below p = CK_P (1e-6).
@@ -35,8 +39,10 @@
  *              bin k      (slab) scattering events in each quarter of the segment, closed form
  *            each within CK_Z (5) standard errors (from the sample variance) of the closed form; then the
  *            cross-tracker invariance z-test: every figure against the built-in `delta` tracker on the
- *            same ray, |difference| <= CK_Z combined standard errors. A tracker may refuse chromatic media
- *            in create() (reported, not a failure); grey media it must take.
+ *            same ray, |difference| <= CK_Z combined standard errors; and the variance lines (tail()):
+ *            each figure's sample variance at most CK_VAR_FACTOR times the analog estimator's, a heavy
+ *            tail (the largest sample's share of the sum of squares) warned of. For each parameter set. A
+ *            tracker may refuse chromatic media in create() (reported, not a failure); grey media it must take.
  * transmittance (an estimator) under the built-in `delta` tracker, through murk_medium_transmittance() as a
  *            shadow ray takes it, on the slab and the checker above and a linear ramp (4 x 4 x 16 voxels
  *            0.2 + 1.1 z on [0,1]^3, a slanted ray through z = 0 and z = 1: optical depth 0.75 / d.z), each
@@ -45,10 +51,13 @@
  *              finite     every estimate finite
  *              >= 0       every channel of every estimate non-negative, unless the plugin's description
  *                         says its estimates may be negative (the word "negative": murk/transmittance.h)
+ *              variance   as for trackers, for each parameter set (check_estimator_tails)
  *            An estimator biased by design (its description says "BIASED", as murk/transmittance.h asks)
  *            has its T figures printed and not judged (SKIP).
  * phase      (a phase function, through the host's medium services as integrators call it) for the default
- *            parameters and two more sets (param_set), wo fixed, N sampled directions:
+ *            parameters, the 25 % / 75 % sets and --set's, wo fixed, N sampled directions (at a sweep
+ *            point, whose lobe may be narrower than the quadrature resolves, those without quadrature:
+ *            each sample against eval(), reciprocity, the sampled mean cosine):
  *              chi2       sample() against eval(): the sphere cut into 16 x 32 cells around the forward
  *                         direction, refined towards it as the mean cosine says (a peak of width ~1 - g spans
  *                         several cells), expected counts by adaptive quadrature of eval() over each cell;
@@ -518,6 +527,8 @@ static int param_sets(ck *c, const murk_plugin_desc *d, ck_set *sets)
     printf("  %d parameter set%s: %s\n", n, n == 1 ? "" : "s",
            c->nassign ? "the --set values" : "the defaults, every range at 25 % and 75 %, each parameter at its ends "
                                              "and every enum and bool value");
+    if (err[0])
+        report(c, 2, "parameters  %s", err);
     return n;
 }
 
@@ -1103,6 +1114,43 @@ static long ph_sample(const ph_ref *r, const murk_sph_grid *g, long n, uint64_t 
     return bad;
 }
 
+/* eval(a, b) = eval(b, a) for 4096 random pairs (relative 1e-4). */
+static void phase_reciprocity(ck *c, const ph_ref *r, const char *label)
+{
+    murk_rng rng;
+    murk_rng_seed(&rng, c->seed, 0x7265636970ull, 4);
+    double worst = 0.0;
+    for (int k = 0; k < 4096; k++) {
+        murk_vec3 a = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        murk_vec3 b = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
+        worst = fmax(worst, rel_diff(r->h->medium_phase_eval(r->m, a, b), r->h->medium_phase_eval(r->m, b, a)));
+    }
+    report(c, worst <= 1e-4, "reciprocity %-20s max rel difference %.1e over 4096 pairs", label, worst);
+}
+
+/* A sweep point (one parameter at a range's end, g = +-0.99 say): its lobe may be narrower than the
+ * quadrature behind chi2, norm and the quadrature's mean cosine resolves, so only what needs none: every
+ * sample's pdf and value against eval(), reciprocity, and the sampled mean cosine against mean_cosine()
+ * within CK_Z standard errors. A sampling routine that breaks near |g| = 1 fails the last. */
+static void check_phase_point(ck *c, const murk_medium *m, const char *label)
+{
+    const murk_phase *ph = murk_media_phase(m);
+    ph_ref r = {murk_host_table(), m, murk_normalize(murk_v3(0.3f, -0.5f, 0.8f))};
+    long n = c->quick ? 50000 : 200000;
+    double mean, se;
+    long bad = ph_sample(&r, NULL, n, c->seed, NULL, &mean, &se);
+    report(c, bad <= n / 10000, "sampling    %-20s eval/sample mismatches or NaN %ld of %ld", label, bad, n);
+    phase_reciprocity(c, &r, label);
+    if (!(ph->vt && MURK_HAS(ph->vt->size, murk_phase_vt, mean_cosine) && ph->vt->mean_cosine)) {
+        report(c, -1, "mean cos    %-20s no closed form (mean_cosine NULL); sampled %.5f +- %.5f", label, mean, se);
+        return;
+    }
+    double gbar = ph->vt->mean_cosine(ph->self);
+    stat_decisions(c, 1, CK_ALPHA_Z);
+    report(c, fabs(mean - gbar) <= CK_Z * se + 1e-6, "mean cos    %-20s closed form %.6f, sampled %.6f +- %.6f (z %.1f)",
+           label, gbar, mean, se, se > 0.0 ? (mean - gbar) / se : 0.0);
+}
+
 static void check_phase_set(ck *c, const murk_medium *m, const char *label)
 {
     const murk_phase *ph = murk_media_phase(m);
@@ -1145,15 +1193,7 @@ static void check_phase_set(ck *c, const murk_medium *m, const char *label)
            terr);
     free(obs);
     free(expd);
-    murk_rng rng;
-    murk_rng_seed(&rng, c->seed, 0x7265636970ull, 4);
-    double worst = 0.0;
-    for (int k = 0; k < 4096; k++) {
-        murk_vec3 a = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
-        murk_vec3 b = dir_of(acos(1.0 - 2.0 * murk_rng_float(&rng)), 2.0 * CK_PI * murk_rng_float(&rng));
-        worst = fmax(worst, rel_diff(r.h->medium_phase_eval(m, a, b), r.h->medium_phase_eval(m, b, a)));
-    }
-    report(c, worst <= 1e-4, "reciprocity %-20s max rel difference %.1e over 4096 pairs", label, worst);
+    phase_reciprocity(c, &r, label);
     if (!has_mean) {
         report(c, -1, "mean cos    %-20s no closed form (mean_cosine NULL); sampled %.5f +- %.5f", label, mean, se);
         return;
@@ -1170,10 +1210,6 @@ static void check_phase(ck *c, const murk_plugin_desc *d)
     int nsets = param_sets(c, d, sets);
     for (int set = 0; set < nsets; set++) {
         char text[4096], err[1024], label[64];
-        /* the full sets only (defaults, 25 % / 75 %, --set): at a range's end (g near +-1) the lobe is
-         * narrower than the quadrature behind chi2, norm and mean cos resolves */
-        if (!sets[set].full)
-            continue;
         snprintf(text, sizeof text, "murk: 1\nmedia:\n  m: { type: delta, phase: { type: %s%.1023s } }\nshapes: []\n",
                  d->name, sets[set].keys);
         murk_scene *s = load_text(c, "phase.yaml", text, err, sizeof err);
@@ -1183,7 +1219,12 @@ static void check_phase(ck *c, const murk_plugin_desc *d)
         }
         printf("  set %d: %s\n", set, sets[set].what);
         snprintf(label, sizeof label, "set %d", set);
-        check_phase_set(c, &s->media[0].m, label);
+        /* the full sets (defaults, 25 % / 75 %, --set) get every check; a sweep point (a range's end, where
+         * the lobe may be narrower than the quadrature resolves) those that need no quadrature */
+        if (sets[set].full)
+            check_phase_set(c, &s->media[0].m, label);
+        else
+            check_phase_point(c, &s->media[0].m, label);
         murk_scene_free(s);
     }
 }

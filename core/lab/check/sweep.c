@@ -58,11 +58,14 @@ static int spread_set(const murk_plugin_desc *d, int which, ck_set *s)
     return any;
 }
 
-/* One parameter at value v (or text), the others at their defaults. */
-static int one_param(ck_set *out, int n, int max, const murk_param *p, double v, const char *text, const char *why)
+/* One parameter at value v (or text), the others at their defaults; counted in *dropped if out is full. */
+static int one_param(ck_set *out, int n, int max, int *dropped, const murk_param *p, double v, const char *text,
+                     const char *why)
 {
-    if (n >= max)
+    if (n >= max) {
+        ++*dropped;
         return n;
+    }
     ck_set *s = &out[n];
     memset(s, 0, sizeof *s);
     if (put_value(s, p, v, text))
@@ -72,19 +75,19 @@ static int one_param(ck_set *out, int n, int max, const murk_param *p, double v,
 }
 
 /* Every value of p worth a set of its own: the ends of its range, each choice of an enum, the other bool. */
-static int sweep_param(const murk_plugin_desc *d, const murk_param *p, ck_set *out, int n, int max)
+static int sweep_param(const murk_plugin_desc *d, const murk_param *p, ck_set *out, int n, int max, int *dropped)
 {
     if (p->flags & MURK_PARAM_NO_SWEEP) /* its other values are for study (murk/plugin.h) */
         return n;
     if (p->type == MURK_PARAM_BOOL)
-        return one_param(out, n, max, p, 0.0, p->def[0] != 0.0 ? "false" : "true", "");
+        return one_param(out, n, max, dropped, p, 0.0, p->def[0] != 0.0 ? "false" : "true", "");
     if (p->type == MURK_PARAM_ENUM) {
-        for (const char *c = p->choices; c && *c && n < max;) {
+        for (const char *c = p->choices; c && *c;) {
             const char *bar = strchr(c, '|');
             char v[128];
             snprintf(v, sizeof v, "%.*s", bar ? (int)(bar - c) : (int)strlen(c), c);
             if (!p->def_str || strcmp(v, p->def_str))
-                n = one_param(out, n, max, p, 0.0, v, "");
+                n = one_param(out, n, max, dropped, p, 0.0, v, "");
             c = bar ? bar + 1 : c + strlen(c);
         }
         return n;
@@ -98,7 +101,7 @@ static int sweep_param(const murk_plugin_desc *d, const murk_param *p, ck_set *o
         double v = end ? p->max : p->min;
         int is_def = p->def[0] == v && (p->type != MURK_PARAM_RGB || (p->def[1] == v && p->def[2] == v));
         if (!is_def)
-            n = one_param(out, n, max, p, v, NULL, end ? ", its maximum" : ", its minimum");
+            n = one_param(out, n, max, dropped, p, v, NULL, end ? ", its maximum" : ", its minimum");
     }
     return n;
 }
@@ -131,15 +134,22 @@ static int from_assignments(const murk_plugin_desc *d, const char *const *assign
 int ck_param_sets(const murk_plugin_desc *d, const char *const *assign, int nassign, ck_set *out, int max, char *err,
                   size_t errlen)
 {
+    if (errlen)
+        err[0] = '\0';
     if (nassign > 0)
         return max > 0 ? from_assignments(d, assign, nassign, out, err, errlen) : 0;
-    int n = 0;
+    int n = 0, dropped = 0;
+    if (max < 3)
+        return 0;
     memset(&out[n], 0, sizeof out[n]);
     out[n].full = 1;
     snprintf(out[n++].what, sizeof out[0].what, "defaults");
-    for (int which = 1; which <= 2 && n < max; which++)
+    for (int which = 1; which <= 2; which++)
         n += spread_set(d, which, &out[n]);
     for (uint32_t i = 0; i < d->nparams; i++)
-        n = sweep_param(d, &d->params[i], out, n, max);
+        n = sweep_param(d, &d->params[i], out, n, max, &dropped);
+    if (dropped) /* said, never silently left out */
+        snprintf(err, errlen, "%d sweep point%s beyond the first %d parameter sets not run (check them with --set)",
+                 dropped, dropped == 1 ? "" : "s", max);
     return n;
 }

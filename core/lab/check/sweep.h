@@ -22,7 +22,7 @@ typedef struct ck_set {
 /* The sets for plugin d into out (at most max): with nassign > 0 the one set of those KEY=VALUE
  * assignments (every KEY a parameter of d, else -1 with err); else the sweep. An integrator's
  * `max_depth` is swept to its maximum only (the furnace's closed form needs unlimited bounces). Returns
- * the count. */
+ * the count; a sweep that did not fit into max sets returns max and says so in err (err is "" otherwise). */
 int ck_param_sets(const murk_plugin_desc *d, const char *const *assign, int nassign, ck_set *out, int max, char *err,
                   size_t errlen);
 
