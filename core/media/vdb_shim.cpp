@@ -234,24 +234,20 @@ private:
                 skip(count * elem, where);
                 continue;
             }
-            unsigned char h[16];
-            if (len < sizeof h)
+            if (len < 16)
                 throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes, shorter than its header"};
-            read(h, sizeof h, where);
-            uint32_t plain = le32(h + 4), packed = le32(h + 12);
+            skip(4, where); /* blosc's header: versions, flags, type size; */
+            uint32_t plain = u32();
+            skip(4, where); /* block size */
+            uint32_t packed = u32();
             if (plain != count * elem || packed != len)
                 throw Failure{where + ": a blosc block of " + std::to_string(len) + " bytes whose header says " +
                               std::to_string(packed) + " bytes, " + std::to_string(plain) + " uncompressed, where " +
                               std::to_string(count * elem) + " are needed"};
-            skip(len - sizeof h, where);
+            skip(len - 16, where);
         }
         size = limit;
         seek(stop);
-    }
-    static uint32_t le32(const unsigned char *b)
-    {
-        return static_cast<uint32_t>(b[0]) | static_cast<uint32_t>(b[1]) << 8 | static_cast<uint32_t>(b[2]) << 16 |
-               static_cast<uint32_t>(b[3]) << 24;
     }
     /* A grid descriptor and the head of its grid: metadata, transform, root counts. */
     void descriptor(uint32_t g)
