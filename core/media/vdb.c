@@ -1,5 +1,7 @@
 /* vdb.c — OpenVDB .vdb density grids, held sparse: the C side of the shim (vdb_shim.cpp reads the file with
- * libopenvdb and hands its tiles and leaves here, to sparse.c's builder). Built without OpenVDB (meson
+ * libopenvdb and hands its tiles and leaves here, to sparse.c's builder). libmurk does not link libopenvdb,
+ * whose relocations would cost every murk process its start-up time: the shim is the module
+ * murk_vdb.so, loaded here the first time a .vdb is read (core/meson.build). Built without OpenVDB (meson
  * -Dopenvdb=disabled, or libopenvdb-dev missing), murk_field_vdb_load says so. */
 #include "media/field_impl.h"
 #include "util/error.h"
@@ -13,6 +15,58 @@
 
 #ifdef MURK_HAVE_OPENVDB
 #include "media/vdb_shim.h"
+
+#include <dlfcn.h>
+#include <limits.h>
+#include <pthread.h>
+#include <string.h>
+
+/* Defined when the shim is linked in (the tests, benches and fuzz harnesses link it statically); in
+ * libmurk.so it is not, and this weak reference is null. */
+int murk_vdb_read(const char *path, const char *grid, uint64_t max_active, const murk_vdb_sink *sink,
+                  murk_vdb_meta *meta, char *err, size_t errlen) __attribute__((weak, visibility("hidden")));
+
+typedef int (*vdb_read_fn)(const char *, const char *, uint64_t, const murk_vdb_sink *, murk_vdb_meta *, char *,
+                           size_t);
+static vdb_read_fn vdb_read;
+static char vdb_load_error[1024];
+static pthread_once_t vdb_once = PTHREAD_ONCE_INIT;
+
+/* dlopen()s the module: beside libmurk (the build tree: core/murk_vdb.so), in the install's LIBDIR/murk
+ * beside libmurk (a moved or staged install), then in the configured prefix's. Kept loaded: OpenVDB keeps
+ * registries that outlive a read. */
+static void vdb_load_module(void)
+{
+    if (murk_vdb_read) {
+        vdb_read = murk_vdb_read;
+        return;
+    }
+    char dir[PATH_MAX];
+    const char *tried[3] = {NULL, NULL, MURK_VDB_MODULE};
+    char beside[2][PATH_MAX + 32];
+    if (murk_library_dir(dir, sizeof dir) == 0) {
+        snprintf(beside[0], sizeof beside[0], "%s/murk_vdb.so", dir);
+        snprintf(beside[1], sizeof beside[1], "%s/murk/murk_vdb.so", dir);
+        tried[0] = beside[0];
+        tried[1] = beside[1];
+    }
+    size_t used = 0;
+    for (int i = 0; i < 3; i++) {
+        if (!tried[i])
+            continue;
+        void *h = dlopen(tried[i], RTLD_NOW | RTLD_LOCAL);
+        void *fn = h ? dlsym(h, "murk_vdb_read") : NULL;
+        if (fn) {
+            memcpy(&vdb_read, &fn, sizeof fn); /* ISO C has no object-to-function pointer cast */
+            return;
+        }
+        const char *why = h ? "it has no murk_vdb_read" : dlerror();
+        int k = snprintf(vdb_load_error + used, sizeof vdb_load_error - used, "%s%s", used ? "; " : "",
+                         why ? why : tried[i]);
+        if (k > 0)
+            used += (size_t)k < sizeof vdb_load_error - used ? (size_t)k : sizeof vdb_load_error - 1 - used;
+    }
+}
 
 typedef struct sink_state {
     const char *path;
@@ -61,7 +115,14 @@ MURK_API murk_field *murk_field_vdb_load(const char *path, const char *grid, int
     sink_state st = {path, NULL};
     murk_vdb_sink sink = {&st, sink_begin, sink_tile, sink_leaf};
     murk_vdb_meta meta;
-    if (murk_vdb_read(path, grid, murk_limit(MURK_LIMIT_GRID_VOXELS), &sink, &meta, err, errlen) != 0) {
+    pthread_once(&vdb_once, vdb_load_module);
+    if (!vdb_read) {
+        murk_err_file(err, errlen, path, "murk was built with OpenVDB, but its module murk_vdb.so cannot be loaded "
+                      "(%s)", vdb_load_error);
+        return NULL;
+    }
+    meta.no_such_grid = 0;
+    if (vdb_read(path, grid, murk_limit(MURK_LIMIT_GRID_VOXELS), &sink, &meta, err, errlen) != 0) {
         murk_sparse_abort(st.b);
         if (no_such_grid)
             *no_such_grid = meta.no_such_grid;

@@ -4,6 +4,7 @@
  * is one line naming the file and the cause. */
 #define _GNU_SOURCE /* dladdr() */
 #include "plugin/plugin_loader.h"
+#include "util/file.h"
 #include "util/runtime.h"
 #include "util/util.h"
 
@@ -75,15 +76,9 @@ int murk_running_uninstalled(void)
  * configured prefix's folder, is only the fallback). 0, or -1 if the library's file is unknown. */
 static int plugindir_beside_libmurk(char *out, size_t n)
 {
-    static const char anchor = 0; /* an address inside libmurk */
-    Dl_info info;
     char lib[PATH_MAX];
-    if (!dladdr(&anchor, &info) || !info.dli_fname || !realpath(info.dli_fname, lib))
+    if (murk_library_dir(lib, sizeof lib) != 0)
         return -1;
-    char *slash = strrchr(lib, '/');
-    if (!slash)
-        return -1;
-    *slash = 0;
     int k = snprintf(out, n, "%s/murk/plugins", lib);
     return k > 0 && (size_t)k < n ? 0 : -1;
 }

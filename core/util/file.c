@@ -1,9 +1,12 @@
-/* file.c — reading input files whole (the density grid readers). */
+/* file.c — reading input files whole (the density grid readers), and the folder libmurk was loaded from. */
+#define _GNU_SOURCE /* dladdr() */
 #include "util/file.h"
 #include "util/error.h"
 #include "util/limit.h"
 
+#include <dlfcn.h>
 #include <errno.h>
+#include <limits.h>
 #include <fcntl.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,3 +85,21 @@ unsigned char *murk_file_read_all(const char *path, uint64_t *size, char *err, s
     return b;
 }
 
+
+int murk_library_dir(char *out, size_t n)
+{
+    static const char anchor = 0; /* an address inside the file that holds this code */
+    Dl_info info;
+    char lib[PATH_MAX];
+    if (!dladdr(&anchor, &info) || !info.dli_fname || !realpath(info.dli_fname, lib))
+        return -1;
+    char *slash = strrchr(lib, '/');
+    if (!slash)
+        return -1;
+    *slash = 0;
+    size_t k = strlen(lib);
+    if (k >= n)
+        return -1;
+    memcpy(out, lib, k + 1);
+    return 0;
+}
