@@ -4,7 +4,10 @@
  * cornell_smoke's cloud (volpath_nee, delta tracking) and a constant chromatic medium in the same box,
  * independent seeds, block-wise z (img_stack_agree: 4x4 blocks, its bounds from stat.h). Roulette divides a survivor by its survival probability, so every rule estimates the
  * same image whatever the threshold; a rule that forgot the division, or divided by the wrong probability,
- * would not. Must fail, on each scene: the default with the lamp 1 % brighter against threshold 1. */
+ * would not. Must fail, on each scene: the default with the lamp 1 % brighter against threshold 1.
+ * The same scenes and stacks check the default render.traversal (Embree's fast traversal) against
+ * `robust` (RTC_SCENE_FLAG_ROBUST): the two differ only where a ray meets an edge to within rounding, so
+ * they must estimate the same image; the must-fail is the brighter lamp against robust. */
 #include "testutil.h"
 
 #include <stdio.h>
@@ -53,22 +56,29 @@ static void test_threshold_keeps_image(void **state)
         const scene_case *c = &cases[i];
         char scene[512], label[160];
         snprintf(scene, sizeof scene, "scenes/%s", c->file);
-        const char *deflt[32], *rule1[32], *rule01[32], *bright[32]; /* the must-fail: the lamp 1.01 x */
+        const char *deflt[32], *rule1[32], *rule01[32], *bright[32], *robust[32]; /* bright: the lamp 1.01 x */
         args_for(c, NULL, 0, deflt);
+        args_for(c, "render.traversal=robust", 0, robust);
         args_for(c, "integrator.rr_threshold=1", 0, rule1);
         args_for(c, "integrator.rr_threshold=0.1", 0, rule01);
         args_for(c, NULL, 1, bright);
-        img_stack a, b, t, m;
+        img_stack a, b, t, m, r;
         img_stack_render(&a, src_path(scene), "rr_default.exr", SEEDS, 100, deflt);
         img_stack_render(&b, src_path(scene), "rr1.exr", SEEDS, 200, rule1);
         img_stack_render(&t, src_path(scene), "rr01.exr", SEEDS, 400, rule01);
         img_stack_render(&m, src_path(scene), "rr_bright.exr", SEEDS, 300, bright);
+        img_stack_render(&r, src_path(scene), "robust.exr", SEEDS, 500, robust);
         snprintf(label, sizeof label, "%s: rr_threshold default (0.3) against 1", c->label);
         nfail += !img_stack_agree(label, &a, &b, BLOCK);
         snprintf(label, sizeof label, "%s: rr_threshold 0.1 against 1", c->label);
         nfail += !img_stack_agree(label, &t, &b, BLOCK);
         snprintf(label, sizeof label, "%s: rr_threshold default with the lamp 1.01 x against 1 (must fail)", c->label);
         nmissed += img_stack_agree(label, &m, &b, BLOCK);
+        snprintf(label, sizeof label, "%s: render.traversal default (fast) against robust", c->label);
+        nfail += !img_stack_agree(label, &a, &r, BLOCK);
+        snprintf(label, sizeof label, "%s: the lamp 1.01 x against robust (must fail)", c->label);
+        nmissed += img_stack_agree(label, &m, &r, BLOCK);
+        img_stack_free(&r);
         img_stack_free(&t);
         img_stack_free(&a);
         img_stack_free(&b);

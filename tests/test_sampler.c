@@ -357,7 +357,7 @@ static void test_scene_key(void **state)
     int rc = run_murk(&log, "render", scene, "-o", out_path("bad.exr"), "--quiet", (char *)NULL);
     assert_int_equal(rc, 1);
     assert_contains(log, "bad_sampler.yaml:2:");
-    assert_contains(log, "render.sampler must be one of sobol|independent, got 'halton'");
+    assert_contains(log, "render.sampler must be one of independent|sobol, got 'halton'");
     free(log);
     rc = run_murk(&log, "render", scene, "-o", out_path("bad.exr"), "--quiet", "--set", "render.sampler=[1]", (char *)NULL);
     assert_int_equal(rc, 1);

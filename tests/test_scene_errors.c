@@ -68,6 +68,8 @@ static const bad_scene corpus[] = {
      "'12' is not an index of the list shapes (it has 8 items)"},
     {"--set non-numeric index", NULL, NULL, "shapes.x.material=red", 1, 8, 1, "'x' is not an index of the list shapes"},
     {"--set path through a scalar", NULL, NULL, "camera.fov.x=3", 1, 12, 1, "cannot descend into a scalar at 'x'"},
+    {"--set unknown traversal", NULL, NULL, "render.traversal=exact", 1, 18, 1,
+     "render.traversal must be one of fast|robust, got 'exact'"},
     {"--set no key", NULL, NULL, "=3", 1, 1, 1, "expected KEY.PATH=VALUE"},
     {"--set no value", NULL, NULL, "render.spp", 1, 1, 1, "expected KEY.PATH=VALUE"},
     {"--set empty path segment", NULL, NULL, "render..spp=3", 1, 8, 1, "empty key in 'render..spp'"},

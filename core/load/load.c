@@ -32,14 +32,33 @@ static murk_rgb to_rgb(const double d[3]) { return murk_rgb3((float)d[0], (float
 /* Prefixes an error that create() returned with the block's location. */
 /* ---- Blocks ------------------------------------------------------------------------------------ */
 
+/* A string that must be one of names[0..n): its index in *out, or a located error listing them. */
+static int read_choice(const murk_ynode *c, const char *what, const char *const *names, size_t n, uint32_t *out,
+                       char *err, size_t errlen)
+{
+    const char *v;
+    if (murk_yread_string(c, what, &v, err, errlen))
+        return -1;
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(v, names[i]) == 0) {
+            *out = (uint32_t)i;
+            return 0;
+        }
+    char list[256] = "";
+    for (size_t i = 0; i < n; i++)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? "|" : "", names[i]);
+    return ERR(c, "%s must be one of %s, got '%s'", what, list, v);
+}
+
 static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t errlen)
 {
-    static const char *const keys[] = {"resolution", "spp", "seed", "exposure", "sampler"};
+    static const char *const keys[] = {"resolution", "spp", "seed", "exposure", "sampler", "traversal"};
     s->width = s->height = 512;
     s->spp = 64;
     s->seed = 0;
     s->exposure = 0.0f;
     s->sampler = MURK_SAMPLER_SOBOL;
+    s->traversal = MURK_TRAVERSAL_FAST;
     if (!n)
         return 0;
     if (murk_yexpect_map(n, "render", err, errlen) || murk_ycheck_keys(n, "render", keys, NKEYS(keys), err, errlen))
@@ -76,16 +95,13 @@ static int load_render(murk_scene *s, const murk_ynode *n, char *err, size_t err
     }
     if ((c = murk_ymap_get(n, "sampler"))) {
         static const char *const samplers[] = {"independent", "sobol"}; /* indexed by MURK_SAMPLER_* */
-        const char *v;
-        long k = -1;
-        if (murk_yread_string(c, "render.sampler", &v, err, errlen))
+        if (read_choice(c, "render.sampler", samplers, NKEYS(samplers), &s->sampler, err, errlen))
             return -1;
-        for (size_t i = 0; i < NKEYS(samplers); i++)
-            if (strcmp(v, samplers[i]) == 0)
-                k = (long)i;
-        if (k < 0)
-            return ERR(c, "render.sampler must be one of sobol|independent, got '%s'", v);
-        s->sampler = (uint32_t)k;
+    }
+    if ((c = murk_ymap_get(n, "traversal"))) {
+        static const char *const modes[] = {"fast", "robust"}; /* indexed by MURK_TRAVERSAL_* */
+        if (read_choice(c, "render.traversal", modes, NKEYS(modes), &s->traversal, err, errlen))
+            return -1;
     }
     return 0;
 }

@@ -35,7 +35,8 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
     rtcSetDeviceMemoryMonitorFunction(s->device, embree_memory, s);
     s->rtc = rtcNewScene(s->device);
     rtcSetSceneBuildQuality(s->rtc, RTC_BUILD_QUALITY_HIGH);
-    rtcSetSceneFlags(s->rtc, RTC_SCENE_FLAG_ROBUST);
+    /* render.traversal: Embree's default unless the scene asks for its robust mode (README.md, "Scene format") */
+    rtcSetSceneFlags(s->rtc, s->traversal == MURK_TRAVERSAL_ROBUST ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     s->nboundaries = 0;
     for (size_t i = 0; i < s->nshapes; i++) {
         murk_shape *sh = &s->shapes[i];

@@ -82,6 +82,10 @@ typedef struct murk_named_medium {
 
 struct murk_texture;
 
+/* render.traversal: Embree's default traversal, or its robust mode (RTC_SCENE_FLAG_ROBUST: conservative
+ * box tests and exact triangle tests, so that fewer rays slip between triangles sharing an edge). */
+enum { MURK_TRAVERSAL_FAST = 0, MURK_TRAVERSAL_ROBUST = 1 };
+
 struct murk_scene {
     murk_ydoc doc;
     murk_registry reg;
@@ -89,7 +93,8 @@ struct murk_scene {
     int width, height, spp;
     uint64_t seed;
     float exposure;
-    uint32_t sampler; /* MURK_SAMPLER_* (render.sampler) */
+    uint32_t sampler;   /* MURK_SAMPLER_* (render.sampler) */
+    uint32_t traversal; /* MURK_TRAVERSAL_* (render.traversal) */
     /* camera */
     murk_vec3 cam_from, cam_at, cam_up;
     float fov;
