@@ -26,16 +26,21 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 
 
-def load(d):
-    with open(os.path.join(d, "bench.json")) as f:
-        meta = json.load(f)
+def load_rows(d):
+    """DIR/bench.csv: one dict per render, every column but the label a float."""
     with open(os.path.join(d, "bench.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
     for r in rows:
         for k in r:
             if k != "label":
                 r[k] = float(r[k])
-    return meta, rows
+    return rows
+
+
+def load(d):
+    with open(os.path.join(d, "bench.json")) as f:
+        meta = json.load(f)
+    return meta, load_rows(d)
 
 
 def mean_se(xs):
