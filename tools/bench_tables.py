@@ -308,8 +308,8 @@ def t_kutz(R, spec):
                      "%.2f" % (run.lookups_per_sample(c) / run.lookups_per_sample(d)),
                      run.spread(vs, "relmse"), run.spread(vs, "max_sample")])
         pairs += [(run, x, d) for x in vs[1:]]
-    return block("Efficiency relative to `delta` (± standard error over 3 seeds), at each run's largest budget; the "
-                 "last two columns span every render of the three trackers (all seeds):",
+    return block("Efficiency relative to `delta` (± standard error over %d seeds), at each run's largest budget; the "
+                 "last two columns span every render of the three trackers (all seeds):" % run.meta["repeat"],
                  ["run", "budget", "relMSE delta", "spectral, time / lookups", "decomposition, time / lookups",
                   "lookups per sample, decomposition / delta", "relMSE of single renders", "max sample"],
                  rows, pairs)
@@ -343,8 +343,8 @@ def t_m_nee(R):
                      fmt(*run.stat(a, "relmse")), fmt(*run.stat(n, "relmse")), run.eff_cell(n, a),
                      run.eff_cell(n, a, None, "lookups")])
         pairs.append((run, n, a))
-    return block("The fourth step: `spectral_mis` with `nee_mis: null_scattering` against `solid_angle` (mean over 3 "
-                 "seeds ± standard error, at each run's largest budget):",
+    return block("The fourth step: `spectral_mis` with `nee_mis: null_scattering` against `solid_angle` (mean over %d "
+                 "seeds ± standard error, at each run's largest budget):" % run.meta["repeat"],
                  ["run", "shadow rays", "budget", "relMSE, solid_angle", "relMSE, null_scattering",
                   "efficiency of null_scattering, equal time", "equal density lookups"], rows, pairs)
 
@@ -366,8 +366,8 @@ def t_g2_steps(R):
                          run.eff_cell(v, base)])
             if v != base:
                 pairs.append((run, v, base))
-    return block("The trackers at %s (equal spp), mean over 3 seeds ± standard error; ratios to per-channel tracking "
-                 "(`naive_spectral`) of the same scene:" % R["g2_spectral_fog_large_light"].budget(),
+    return block("The trackers at %s (equal spp), mean over %d seeds ± standard error; ratios to per-channel tracking "
+                 "(`naive_spectral`) of the same scene:" % (R["g2_spectral_fog_large_light"].budget(), run.meta["repeat"]),
                  ["scene", "tracker", "relMSE", "relMSE per sample, vs naive_spectral", "MSE, vs naive_spectral",
                   "RMSE", "efficiency, equal time"], rows, pairs)
 
@@ -395,10 +395,10 @@ def t_g2_nee(R):
         if label.startswith("nee_mis=null"):
             more = "paired relMSE per sample: %s" % judge(*run.paired(v, s, "relmse"), "higher", "lower")
             pairs += [(run, v, s, more)] + ([(run, v, d)] if d != s else [])
-    return block("The fourth step at %s (equal spp), mean over 3 seeds ± standard error. *Paired*: each seed's figure "
+    return block("The fourth step at %s (equal spp), mean over %d seeds ± standard error. *Paired*: each seed's figure "
                  "over the same seed's with `solid_angle` weights and the same shadow rays (ratio tracking), mean ± "
-                 "standard error of the 3 ratios; *default*: `solid_angle` with the scene's default shadow rays "
-                 "(residual ratio tracking):" % box.budget(),
+                 "standard error of the %d ratios; *default*: `solid_angle` with the scene's default shadow rays "
+                 "(residual ratio tracking):" % (box.budget(), box.meta["repeat"], box.meta["repeat"]),
                  ["scene", "variant", "relMSE", "RMSE", "relMSE per sample, vs default",
                   "paired relMSE, %s" % box.budget(), "paired relMSE, %s" % box.budget(small),
                   "paired MSE, %s" % box.budget(), "efficiency vs default, equal time"], rows, pairs)
