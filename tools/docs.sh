@@ -10,7 +10,8 @@
 #   glass          docs/glass/*.png (scenes/glass.sh)
 #   transmittance  docs/results/transmittance.csv and transmittance_*.png (docs/results/plot.py)
 #   stability      docs/stability.md and docs/stability/*.png (bench/stability/atlas.py)
-#   bench          docs/results/bench/*: the `murk bench` runs results.md quotes (charts, report.md, bench.csv)
+#   bench          docs/results/bench/*: every `murk bench` run results.md quotes (charts, report.md, bench.csv,
+#                  bench.json), then results.md's tables of them, spliced in by tools/bench_tables.py
 #   page           docs/report_page.png, the comparison page in headless Chromium (skipped without chromium)
 #
 # --scale S multiplies every sample count and time budget (default 1: the counts the docs state; the long
@@ -30,7 +31,7 @@ while [ $# -gt 0 ]; do
     --scale) SCALE=$2; shift 2 ;;
     --docs) DOCS=$2; shift 2 ;;
     --out) OUT=$2; shift 2 ;;
-    -h|--help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "docs.sh: unknown option $1" >&2; exit 2 ;;
     *) break ;;
   esac
@@ -100,22 +101,21 @@ part_stability() {
   fi
 }
 
-# bench NAME SCENE ARGS... with --spp LIST / --time LIST / --ref-spp N scaled, into DOCS/results/bench/NAME
+# bench NAME SCENE ARGS... with --spp LIST / --time LIST / --ref-spp N scaled, into DOCS/results/bench/NAME;
+# each argument is passed on as one word (a --set value may hold spaces)
 bench() {
   name=$1 scene=$2; shift 2
-  set -f
-  args=""
-  while [ $# -gt 0 ]; do
-    case $1 in
-      --spp) args="$args --spp $(list "$2")"; shift 2 ;;
-      --time) args="$args --time $(tlist "$2")"; shift 2 ;;
-      --ref-spp) args="$args --ref-spp $(n "$2" 4)"; shift 2 ;;
-      *) args="$args $1"; shift ;;
+  left=$#
+  while [ "$left" -gt 0 ]; do   # rotate the arguments through "$@", scaling the budgets on the way
+    a=$1; shift; left=$((left - 1))
+    case $a in
+      --spp) set -- "$@" --spp "$(list "$1")"; shift; left=$((left - 1)) ;;
+      --time) set -- "$@" --time "$(tlist "$1")"; shift; left=$((left - 1)) ;;
+      --ref-spp) set -- "$@" --ref-spp "$(n "$1" 4)"; shift; left=$((left - 1)) ;;
+      *) set -- "$@" "$a" ;;
     esac
   done
-  # shellcheck disable=SC2086  # args is a word list without globs (set -f)
-  "$MURK" bench "$scene" $args --threads 2 -o "$DOCS/results/bench/$name"
-  set +f
+  "$MURK" bench "$scene" "$@" --threads 2 -o "$DOCS/results/bench/$name"
 }
 
 part_bench() {
@@ -147,6 +147,46 @@ part_bench() {
     --set 'render.resolution=[64,48]' --spp 4,16 --ref-spp 256
   bench lights_spot_fog scenes/spot_fog.yaml \
     --vary media.fog.type=delta,decomposition,spectral,spectral_mis,naive_spectral --set "$R64" --spp 4,16 --ref-spp 256
+  # f.: Kutz 2017 on the cloud in sunlight, under the sky (k*_sky*) and in the scene's first version (sun sphere)
+  HG='media.cloud.phase={type: hg, g: 0.6}' KUTZ='media.cloud.type=delta,spectral,decomposition'
+  KREF='media.cloud.type=delta'
+  bench k_dense_cloud_sun_sky scenes/dense_cloud_sun.yaml --vary "$KUTZ" --set "$R64" --time 2,6 --ref-spp 1024 \
+    --ref-set "$KREF"
+  bench k2_dense_cloud_sun_sky_hg scenes/dense_cloud_sun.yaml --vary "$KUTZ" --set "$HG" --set "$R64" --time 2,6 \
+    --ref-spp 1024 --ref-set "$KREF"
+  bench k3_dense_cloud_sun_sky_hg_spp scenes/dense_cloud_sun.yaml --vary "$KUTZ" --set "$HG" --set "$R64" --spp 16,64 \
+    --ref-spp 1024 --ref-set "$KREF"
+  bench k_dense_cloud_sun scenes/dense_cloud_sun_first.yaml --vary "$KUTZ" --set "$R64" --time 2,6 --ref-spp 1024 \
+    --ref-set "$KREF"
+  bench k2_dense_cloud_sun_hg scenes/dense_cloud_sun_first.yaml --vary "$KUTZ" --set "$HG" --set "$R64" --time 2,6 \
+    --ref-spp 1024 --ref-set "$KREF"
+  bench k3_dense_cloud_sun_smooth scenes/dense_cloud_sun_first.yaml --vary media.cloud.type=delta,decomposition \
+    --set "$HG" --set media.cloud.density.cloud.octaves=2 --set media.cloud.majorant_resolution=32 --set "$R64" \
+    --time 2,6 --ref-spp 1024 --ref-set "$KREF"
+  # g.: Miller 2019's four steps on spectral_extinction
+  MREF='media.medium.type=spectral_mis'
+  bench m_spectral_extinction scenes/spectral_extinction.yaml --vary media.medium.type=naive_spectral,spectral,spectral_mis \
+    --set "$R64" --time 2,6 --ref-spp 2048 --ref-set "$MREF"
+  bench m2_spectral_extinction_nee_mis scenes/spectral_extinction.yaml --vary integrator.nee_mis=solid_angle,null_scattering \
+    --set "$MREF" --set "$R64" --time 2,6 --ref-spp 2048 --ref-set "$MREF"
+  bench m3_spectral_extinction_nee_mis_ratio scenes/spectral_extinction.yaml \
+    --vary integrator.nee_mis=solid_angle,null_scattering --set "$MREF" --set media.medium.transmittance=ratio \
+    --set "$R64" --time 2,6 --ref-spp 2048 --ref-set "$MREF"
+  bench m4_spectral_extinction_nee_mis_spp scenes/spectral_extinction.yaml \
+    --vary integrator.nee_mis=solid_angle,null_scattering --set "$MREF" --set media.medium.transmittance=ratio \
+    --set "$R64" --spp 16,64 --ref-spp 2048 --ref-set "$MREF"
+  # h.: every tracker, shadow-ray estimator and NEE weighting on the explosion
+  EREF='media.fire.type=spectral_mis'
+  bench e_explosion_trackers scenes/explosion.yaml \
+    --vary media.fire.type=delta,decomposition,spectral,spectral_mis,naive_spectral --set "$R64" --time 2,6 \
+    --ref-spp 1024 --ref-set "$EREF"
+  bench e2_explosion_estimators scenes/explosion.yaml \
+    --vary media.fire.transmittance=residual_ratio,ratio,track_length,unbiased_raymarch,power_series --set "$R64" \
+    --time 2,6 --ref-spp 1024 --ref-set "$EREF"
+  bench e3_explosion_nee_mis scenes/explosion.yaml --vary integrator.nee_mis=solid_angle,null_scattering --set "$R64" \
+    --time 2,6 --ref-spp 1024 --ref-set "$EREF"
+  # results.md's tables of these runs (sections a.-h.), written from the runs just made
+  "$PYTHON" tools/bench_tables.py --results "$DOCS/results.md" --bench "$DOCS/results/bench"
 }
 
 part_page() {
