@@ -18,6 +18,7 @@ and passing on an unchanged copy.
 """
 import argparse
 import difflib
+import math
 import os
 import re
 import shutil
@@ -125,7 +126,7 @@ def judge(r, sr, above="more efficient", below="less efficient"):
     z = abs(r - 1) / sr
     zs = "%.1f" % z
     if z < RESOLVED_SE and float(zs) >= RESOLVED_SE:
-        zs = "%.2f" % z  # 1.96 is not 2.0
+        zs = "%.2f" % (math.floor(z * 100) / 100)  # 1.996 is shown 1.99: below the rule, as it is
     if z >= RESOLVED_SE:
         return "resolved, %s (%s×, %s se)" % (above if r > 1 else below, fmt(r, sr), zs)
     return "not resolved (%s×, %s se)" % (fmt(r, sr), zs)
