@@ -1,7 +1,8 @@
 #!/bin/sh
 # glass.sh — regenerates docs/glass.md's strips (docs/glass/*.png): glass_juice and glass_cloud with the
 # medium's tracker swapped (delta, spectral, spectral_mis) AT EQUAL TIME, relMSE against a longer
-# reference of another seed. EXRs, logs and the table of spp, time and relMSE go to out/glass/.
+# reference of another seed. EXRs, logs and the table of spp, time and relMSE go to out/glass/; the table
+# is also spliced into DOCS/glass.md between its markers (tools/mdsplice.py).
 #
 #   scenes/glass.sh            # about 4 minutes on 2 busy cores
 #
@@ -50,6 +51,7 @@ for scene in juice cloud; do
     printf '%s\n' "$OUT/${scene}_$tr.png:$tr\\n$1 spp, $2 s\\nrelMSE $r" >> "$list"
   done
   set -- $(cat "$OUT/${scene}_ref.stats")
+  printf '%s\t%s\t%s\t-\n' "${scene}_ref" "$1" "$2" >> "$TABLE"
   printf '%s\n' "$OUT/${scene}_ref.png:reference (spectral_mis, seed 1)\\n$1 spp, $2 s" >> "$list"
   title="glass_$scene: the medium's tracker at equal time ($T s each), 256x256"
   IFS=$NL
@@ -58,3 +60,8 @@ for scene in juice cloud; do
   "$PYTHON" bench/strip.py --title "$title" "$DOC/$scene.png" "$@"
 done
 cat "$TABLE"
+# glass.md's table: "juice_spectral_mis" is scene glass_juice, tracker spectral_mis
+awk -F '\t' 'NR == 1 { print "| scene | tracker | spp | seconds | relMSE |"; print "|---|---|---|---|---|"; next }
+  { i = index($1, "_"); t = substr($1, i + 1); if (t == "ref") t = "reference (spectral_mis, seed 1)"
+    printf "| glass_%s | %s | %s | %s | %s |\n", substr($1, 1, i - 1), t, $2, $3, ($4 == "-" ? "—" : sprintf("%.3g", $4)) }' \
+  "$TABLE" | "$PYTHON" tools/mdsplice.py "${DOCS:-docs}/glass.md" "glass table" scenes/glass.sh
