@@ -1,7 +1,9 @@
 #!/bin/sh
 # figures.sh — regenerates the gallery (docs/gallery.md, docs/gallery/*.png): the five figures of the
 # reference report re-rendered by murk. EXRs, logs and a table of every render's spp, time and relMSE
-# go to out/gallery/ (not committed); the strips with their captions go to docs/gallery/.
+# go to out/gallery/ (not committed); the strips with their captions go to docs/gallery/, and the numbers
+# gallery.md quotes (Figure 2's comparison, Figure 3's and Figure 4's tables) are spliced into
+# DOCS/gallery.md between its markers (tools/mdsplice.py, bench/figure4.py).
 #
 #   scenes/figures.sh [FIGURE ...]      # figures 1..5, default: 2 3 4 5
 #
@@ -51,13 +53,21 @@ render() {
   cat "$OUT/$name.stats"
 }
 
-# relmse NAME REF : relMSE of $OUT/NAME.exr against $OUT/REF.exr, appended to the results table
+# relmse NAME REF : relMSE of $OUT/NAME.exr against $OUT/REF.exr, appended to the results table and
+# kept in $OUT/NAME.relmse
 relmse() {
   r=$("$MURK" compare "$OUT/$1.exr" "$OUT/$2.exr" | awk '/^MSE/ {print $4}')
+  printf '%s\n' "$r" > "$OUT/$1.relmse"
   set -- "$1" "$2" "$r" $(cat "$OUT/$1.stats")
   printf '%s\t%s\t%s\t%s\n' "$1" "$4" "$5" "$3" >> "$TABLE"
   printf '%s' "$3"
 }
+
+# e2 X : X in the docs' short exponent form, 6.35e-3
+e2() { awk -v x="$1" 'BEGIN { s = sprintf("%.2e", x); sub(/e-0/, "e-", s); sub(/e\+0/, "e", s); print s }'; }
+
+# splice NAME : standard input into DOCS/gallery.md's block NAME
+splice() { "$PYTHON" tools/mdsplice.py "$DOCS/gallery.md" "$1" scenes/figures.sh; }
 
 # caption NAME LABEL [REF] : "LABEL\nN spp, T s[\nrelMSE X]" for bench/strip.py
 caption() {
@@ -83,11 +93,15 @@ figure2() {
   "$MURK" compare "$OUT/bunny_control0.exr" "$OUT/bunny_delta.exr" --diff "$OUT/bunny_diff.png" \
     | tee "$OUT/bunny_diff.txt"
   rel=$(awk '/^MSE/ {print $4}' "$OUT/bunny_diff.txt")
+  absrel=$(awk '/^MSE/ {print $6}' "$OUT/bunny_diff.txt")
   white=$(sed -n 's/.*99th percentile (\([^)]*\)).*/\1/p' "$OUT/bunny_diff.txt" | head -n 1)
   "$PYTHON" bench/strip.py --title "Figure 2: decomposition at control 0 vs delta tracking" "$DOC/fig2_bunny.png" \
     "$OUT/bunny_control0.png:$(caption bunny_control0 'decomposition, control 0')" \
     "$OUT/bunny_delta.png:$(caption bunny_delta 'delta tracking')" \
     "$OUT/bunny_diff.png:|control 0 - delta|, relMSE $rel\\nwhite = $white (99th percentile)"
+  printf 'The strip: 256x256, %s spp (control 0) and %s spp (delta); control 0 against delta: relMSE %s, mean abs\nrel %s, the white of the difference image (its 99th percentile of |control 0 − delta|) %s.\n' \
+    "$(cut -d' ' -f1 "$OUT/bunny_control0.stats")" "$(cut -d' ' -f1 "$OUT/bunny_delta.stats")" \
+    "$(e2 "$rel")" "$(e2 "$absrel")" "$(e2 "$white")" | splice "fig2 numbers"
 }
 
 figure3() {
@@ -107,6 +121,15 @@ figure3() {
     "$OUT/smoke_m4.png:$(caption smoke_m4 'majorant x4' smoke_reference)" \
     "$OUT/smoke_c0.5.png:$(caption smoke_c0.5 'control 0.5' smoke_reference)" \
     "$OUT/smoke_c0.1.png:$(caption smoke_c0.1 'control 0.1' smoke_reference)"
+  { echo "| variant | spp | time | relMSE |"; echo "|---|---|---|---|"
+    for v in 'm1:majorant x1, control 1' 'm1.01:majorant x1.01 (report: null 1 %)' \
+      'm1.1:majorant x1.1 (report: null 10 %)' 'm2:majorant x2' 'm4:majorant x4' 'c0.5:control 0.5' \
+      'c0.1:control 0.1' 'reference:reference: delta, seed 1'; do
+      name=smoke_${v%%:*}
+      r=—; [ ! -f "$OUT/$name.relmse" ] || [ "$name" = smoke_reference ] || r=$(e2 "$(cat "$OUT/$name.relmse")")
+      awk -v l="${v#*:}" -v r="$r" '{ printf "| %s | %s | %.1f s | %s |\n", l, $1, $2, r }' "$OUT/$name.stats"
+    done
+  } | splice "fig3 table"
 }
 
 figure4() {   # timed: not niced; the table is spliced into DOCS/gallery.md
