@@ -7,7 +7,10 @@
 Runs BUILD_DIR/bench/transmittance (see bench/transmittance.c), keeps its CSV, and draws per scene the
 error of the mean of n estimates, sqrt(bias^2 + var / n) averaged over the channels' MSE, against the
 density lookups (n x lookups per estimate) and against the time (n x time per estimate) it costs.
-A biased estimator's curve flattens at its floor sqrt(bias^2). Debian's python3-matplotlib."""
+A biased estimator's curve flattens at its floor sqrt(bias^2). After a measurement (not with --from-csv) it
+also writes results.md's two tables of it between their markers (tools/mdsplice.py): lookups and efficiency
+per estimator ("transmittance table") and the raymarch baselines' bias floors ("transmittance bias floor").
+Debian's python3-matplotlib."""
 import csv
 import os
 import subprocess
@@ -20,6 +23,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tools"))
 import pngmeta  # noqa: E402 (tools/pngmeta.py: the murk:commit text key)
+from mdsplice import splice  # noqa: E402
 
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(os.path.dirname(here))
@@ -35,8 +39,9 @@ else:
     build = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "build")
     nseg = sys.argv[2] if len(sys.argv) > 2 else "200"
     nest = sys.argv[3] if len(sys.argv) > 3 else "1000"
-    out = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
-                         capture_output=True, text=True).stdout
+    run = subprocess.run([os.path.join(build, "bench", "transmittance"), nseg, nest], check=True,
+                         capture_output=True, text=True)
+    out = run.stdout
     with open(os.path.join(here, "transmittance.csv"), "w") as f:
         f.write(out)
 rows = list(csv.DictReader(out.splitlines()))
@@ -77,4 +82,65 @@ for scene in dict.fromkeys(r["scene"] for r in rows):
     fig.tight_layout()
     fig.savefig(os.path.join(here, f"transmittance_{scene}.png"), dpi=90, metadata=pngmeta.metadata())
     plt.close(fig)
+
+
+SHORT = {"cornell_smoke": "smoke", "dense_cloud": "dense", "chromatic_smoke": "chromatic"}
+LABELS = {"ratio": "`ratio`", "residual_ratio": "`residual_ratio` (control 1)", "track_length": "`track_length`",
+          "unbiased_raymarch": "`unbiased_raymarch` (depth_step 1, order 1)",
+          "unbiased_raymarch_ds4": "`unbiased_raymarch` depth_step 4",
+          "unbiased_raymarch_ds0.25": "`unbiased_raymarch` depth_step 0.25",
+          "power_series": "`power_series` (chunk_depth 4)", "power_series_cd1": "`power_series` chunk_depth 1",
+          "power_series_cd16": "`power_series` chunk_depth 16"}
+
+
+def label(name):
+    if name.startswith("raymarch_"):
+        return "`raymarch` step %s (**BIASED**)" % name.split("_", 1)[1]
+    return LABELS.get(name, "`%s`" % name)
+
+
+def sci(x, spec="%.1e"):
+    """3.9e-3, not 3.9e-03."""
+    return (spec % x).replace("e-0", "e-").replace("e+0", "e+").replace("e+", "e")
+
+
+def tables(rows, nseg, nest, mean_t):
+    """results.md's two generated blocks: the table of lookups and efficiencies, and the bias floors."""
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    at = {(r["scene"], r["estimator"]): r for r in rows}
+    head = ", ".join(SHORT.get(sc, sc) for sc in scenes)
+    cols = (("lookups", "lookups / estimate", "%.1f"), ("eff_lookups", "efficiency in lookups vs ratio", "%.3g"),
+            ("eff_time", "efficiency in time vs ratio", "%.3g"))
+    t = ["| estimator | " + " | ".join("%s (%s)" % (c[1], head) for c in cols) + " |", "|---" * (1 + len(cols)) + "|"]
+    for nm in dict.fromkeys(r["estimator"] for r in rows):
+        t.append("| %s | " % label(nm) + " | ".join(", ".join(c[2] % float(at[sc, nm][c[0]]) for sc in scenes)
+                                                   for c in cols) + " |")
+    t += ["", "`bench/transmittance %s %s`: %s segments per scene, %s estimates per segment%s.\nFor `raymarch` "
+          "the efficiency is that of one estimate; its error floor is below." % (
+              nseg, nest, nseg, nest, "; mean reference transmittance " + ", ".join(
+                  "%.2g" % mean_t[sc] for sc in scenes) if all(sc in mean_t for sc in scenes) else "")]
+    f = ["| raymarch step | bias floor sqrt(bias²) of the worst channel, " + " | ".join(SHORT.get(sc, sc) for sc in scenes)
+         + " |", "|---" * (1 + len(scenes)) + "|"]
+    for nm in (n for n in dict.fromkeys(r["estimator"] for r in rows) if n.startswith("raymarch_")):
+        cells = []
+        for sc in scenes:
+            r = at[sc, nm]
+            c = max("rgb", key=lambda c: float(r["bias2_" + c]))
+            b2, var = float(r["bias2_" + c]), float(r["var_" + c])
+            # bias^2 at most half the variance of the mean of the estimates is within the measurement's noise
+            cells.append("≤ %s (at the measurement's noise)" % sci(b2 ** 0.5, "%.0e") if b2 <= 0.5 * var / float(nest)
+                         else sci(b2 ** 0.5))
+        f.append("| %s | %s |" % (nm.split("_", 1)[1], " | ".join(cells)))
+    return "\n".join(t), "\n".join(f)
+
+
+if len(sys.argv) <= 2 or sys.argv[1] != "--from-csv":  # a measurement: its tables into results.md
+    mean_t = {}
+    for line in run.stderr.splitlines():  # "cornell_smoke: 200 segments, mean reference T 0.1912"
+        if ": " in line and "mean reference T " in line:
+            mean_t[line.split(":")[0]] = float(line.rsplit(" ", 1)[1])
+    md = os.path.join(os.path.dirname(here), "results.md")
+    table, floor = tables(rows, nseg, nest, mean_t)
+    splice(md, "transmittance table", "docs/results/plot.py", table)
+    splice(md, "transmittance bias floor", "docs/results/plot.py", floor)
 print(out, end="")
