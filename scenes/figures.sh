@@ -5,7 +5,7 @@
 # gallery.md quotes (Figure 2's comparison, Figure 3's and Figure 4's tables) are spliced into
 # DOCS/gallery.md between its markers (tools/mdsplice.py, bench/figure4.py).
 #
-#   scenes/figures.sh [FIGURE ...]      # figures 1..5, default: 2 3 4 5
+#   scenes/figures.sh [FIGURE ...]      # figures 1..5, lights, media; default: 2 3 4 5
 #
 #   1  GGX roughness rows, murk's scale and the report's (alpha:), and albedo/specular (docs/ggx_*.png)
 #   2  Cornell box + bunny: decomposition at control 0 beside delta tracking (transmittance: ratio on
@@ -14,8 +14,11 @@
 #   4  the three spectral scenes on heterogeneous media: the report's three-pass naive baseline, murk's
 #      hero-per-path naive, spectral, spectral_mis, in interleaved timed rounds (bench/figure4.py)
 #   5  the final scene, scenes/axe_room.yaml
+#   lights  the scenes of the lights: block (envmap_spheres, spot_fog, cloud_sun), docs/gallery/lights_*.png
+#   media   issue 27's media: dense_cloud_sun (Mie droplets in sunlight) and explosion (blackbody emission)
 #
-# Every render but figure 4's (timed) runs under `nice -n 10` with murk's default thread count.
+# Every render but figure 4's (timed) runs under `nice -n 10` with murk's default thread count. Figures 1,
+# 5, lights and media splice a table of their renders (size, spp, seconds, load average) into gallery.md.
 # Environment: MURK (the murk executable, default ./build/core/murk), SCALE (multiplies every spp,
 # default 1; tools/docs.sh passes its --scale), DOCS (the docs folder written, default docs; the strips go
 # to DOCS/gallery), OUT (renders, logs, tables; default out/gallery), REUSE=1 (keep renders already in
@@ -38,18 +41,21 @@ mkdir -p "$OUT" "$DOC"
 TABLE=$OUT/results.txt
 [ -f "$TABLE" ] || printf 'image\tspp\tseconds\trelMSE\n' > "$TABLE"
 
-# render NAME SCENE ARGS... : renders $OUT/NAME.exr; leaves "SPP SECONDS" in $OUT/NAME.stats
+# render NAME SCENE ARGS... : renders $OUT/NAME.exr; leaves "SPP SECONDS WxH LOAD_BEFORE LOAD_AFTER" in
+# $OUT/NAME.stats (the 1-minute load averages)
 render() {
   name=$1; scene=$2; shift 2
   if [ "${REUSE:-0}" = 1 ] && [ -s "$OUT/$name.stats" ] && [ -f "$OUT/$name.exr" ]; then
     echo "== $name: reused"; return 0
   fi
   echo "== $name: murk render $scene $*"
+  l0=$(cut -d' ' -f1 /proc/loadavg)
   nice -n 10 "$MURK" render "$scene" -o "$OUT/$name.exr" "$@" > "$OUT/$name.log" 2>&1 ||
     { cat "$OUT/$name.log"; exit 1; }
+  l1=$(cut -d' ' -f1 /proc/loadavg)
   # murk's summary: "NAME.exr, NAME.png: WxH, N spp, T s, ..."
-  sed -n 's/.*: [0-9]*x[0-9]*, \([0-9]*\) spp, \([0-9.]*\) s,.*/\1 \2/p' "$OUT/$name.log" | tail -n 1 \
-    > "$OUT/$name.stats"
+  sed -n 's/.*: \([0-9]*x[0-9]*\), \([0-9]*\) spp, \([0-9.]*\) s,.*/\2 \3 \1/p' "$OUT/$name.log" | tail -n 1 |
+    sed "s/\$/ $l0 $l1/" > "$OUT/$name.stats"
   cat "$OUT/$name.stats"
 }
 
@@ -69,6 +75,14 @@ e2() { awk -v x="$1" 'BEGIN { s = sprintf("%.2e", x); sub(/e-0/, "e-", s); sub(/
 # splice NAME : standard input into DOCS/gallery.md's block NAME
 splice() { "$PYTHON" tools/mdsplice.py "$DOCS/gallery.md" "$1" scenes/figures.sh; }
 
+# renders_table NAME... : a Markdown table of the renders NAME (scenes/NAME.yaml) from their stats
+renders_table() {
+  echo "| scene | size | spp | seconds | load average before–after |"; echo "|---|---|---|---|---|"
+  for name in "$@"; do
+    awk -v s="$name" '{ printf "| `scenes/%s.yaml` | %s | %s | %s | %s–%s |\n", s, $3, $1, $2, $4, $5 }' "$OUT/$name.stats"
+  done
+}
+
 # caption NAME LABEL [REF] : "LABEL\nN spp, T s[\nrelMSE X]" for bench/strip.py
 caption() {
   set -- "$1" "$2" "${3:-}" $(cat "$OUT/$1.stats")
@@ -82,6 +96,7 @@ figure1() {
     render "$s" "scenes/$s.yaml" --spp "$(n 256)"
     cp "$OUT/$s.png" "$DOCS/$s.png"
   done
+  renders_table ggx_roughness ggx_roughness_alpha ggx_albedo_specular | splice "fig1 renders"
 }
 
 figure2() {
@@ -139,12 +154,31 @@ figure4() {   # timed: not niced; the table is spliced into DOCS/gallery.md
 figure5() {
   render axe_room scenes/axe_room.yaml --spp "$(n 256)"
   cp "$OUT/axe_room.png" "$DOC/axe_room.png"
+  renders_table axe_room | splice "fig5 render"
+}
+
+lights() {   # each at its own size, 64 spp at scale 1
+  for s in envmap_spheres spot_fog cloud_sun; do
+    render "$s" "scenes/$s.yaml" --spp "$(n 64)"
+    cp "$OUT/$s.png" "$DOC/lights_$s.png"
+  done
+  renders_table envmap_spheres spot_fog cloud_sun | splice "lights renders"
+}
+
+media() {   # issue 27: 256x256
+  render dense_cloud_sun scenes/dense_cloud_sun.yaml --spp "$(n 128)"
+  render explosion scenes/explosion.yaml --spp "$(n 256)"
+  for s in dense_cloud_sun explosion; do cp "$OUT/$s.png" "$DOC/$s.png"; done
+  renders_table dense_cloud_sun explosion | splice "media renders"
 }
 
 for fig in ${*:-2 3 4 5}; do   # (not $f: the figure functions use f as their own loop variable)
   case $fig in
-    1|2|3|4|5) start=$(date +%s); "figure$fig"; echo "figure $fig: $(( $(date +%s) - start )) s wall" | tee -a "$OUT/walltime.txt" ;;
-    *) echo "usage: scenes/figures.sh [FIGURE ...]   (figures 1..5)" >&2; exit 2 ;;
+    1|2|3|4|5|lights|media)
+      start=$(date +%s)
+      case $fig in [1-5]) "figure$fig" ;; *) "$fig" ;; esac
+      echo "figure $fig: $(( $(date +%s) - start )) s wall" | tee -a "$OUT/walltime.txt" ;;
+    *) echo "usage: scenes/figures.sh [FIGURE ...]   (figures 1..5, lights, media)" >&2; exit 2 ;;
   esac
 done
 echo "results: $TABLE"
