@@ -105,14 +105,18 @@ def verdict(s, S):
     n, sp, h, m = S["naive3"], S["spectral"], S["naive_spectral"], S["spectral_mis"]
     t = lambda a, b, k: a[k][0] / b[k][0]  # noqa: E731 (ratio of medians)
     sep = lambda a, b, k: "apart" if apart(a[k], b[k]) else "overlap"  # noqa: E731
+    # the efficiency ratio's bounds from the spreads: the three passes at their best against spectral at its worst
+    lo = n["relmse"][1] * n["seconds"][1] / (sp["relmse"][2] * sp["seconds"][2])
+    hi = n["relmse"][2] * n["seconds"][2] / (sp["relmse"][1] * sp["seconds"][1])
     return ("- %s: three-pass naive / spectral = **%.2f×** the time (%s), %.2f× the density lookups\n"
             "  - per unit time spectral tracking is %.2f× as efficient as the three passes (median relMSE × median "
-            "time; relMSE spreads %s)\n"
+            "time; %.2f–%.2f× between the spreads' extremes: %s)\n"
             "  - against spectral tracking: murk's one-render naive takes %.2f× its time (spreads %s) with %.2f× its "
             "relMSE (spreads %s); spectral MIS %.2f× its time (spreads %s) with %.2f× its relMSE (spreads %s)" % (
                 s, t(n, sp, "seconds"), "resolved: the spreads do not overlap" if apart(n["seconds"], sp["seconds"])
                 else "NOT resolved: the spreads overlap", n["lookups"] / sp["lookups"],
-                t(n, sp, "relmse") * t(n, sp, "seconds"), sep(n, sp, "relmse"),
+                t(n, sp, "relmse") * t(n, sp, "seconds"), lo, hi,
+                "resolved" if lo > 1 or hi < 1 else "NOT resolved",
                 t(h, sp, "seconds"), sep(h, sp, "seconds"), t(h, sp, "relmse"), sep(h, sp, "relmse"),
                 t(m, sp, "seconds"), sep(m, sp, "seconds"), t(m, sp, "relmse"), sep(m, sp, "relmse")))
 
