@@ -117,7 +117,7 @@ def tables(rows, nseg, nest, mean_t):
                                                    for c in cols) + " |")
     t += ["", "`bench/transmittance %s %s`: %s segments per scene, %s estimates per segment%s.\nFor `raymarch` "
           "the efficiency is that of one estimate; its error floor is below." % (
-              nseg, nest, nseg, nest, "; mean reference transmittance " + ", ".join(
+              nseg, nest, nseg, nest, ";\nmean reference transmittance " + ", ".join(
                   "%.2g" % mean_t[sc] for sc in scenes) if all(sc in mean_t for sc in scenes) else "")]
     f = ["| raymarch step | bias floor sqrt(bias²) of the worst channel, " + " | ".join(SHORT.get(sc, sc) for sc in scenes)
          + " |", "|---" * (1 + len(scenes)) + "|"]
