@@ -104,16 +104,25 @@ def sci(x, spec="%.1e"):
     return (spec % x).replace("e-0", "e-").replace("e+0", "e+").replace("e+", "e")
 
 
+def eff(x):
+    """An efficiency ratio: three significant digits, whole numbers from 1000 on."""
+    return "%.0f" % x if x >= 1000 else "%.3g" % x
+
+
+def fmt(spec, x):
+    return spec(x) if callable(spec) else spec % x
+
+
 def tables(rows, nseg, nest, mean_t):
     """results.md's two generated blocks: the table of lookups and efficiencies, and the bias floors."""
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     at = {(r["scene"], r["estimator"]): r for r in rows}
     head = ", ".join(SHORT.get(sc, sc) for sc in scenes)
-    cols = (("lookups", "lookups / estimate", "%.1f"), ("eff_lookups", "efficiency in lookups vs ratio", "%.3g"),
-            ("eff_time", "efficiency in time vs ratio", "%.3g"))
+    cols = (("lookups", "lookups / estimate", "%.1f"), ("eff_lookups", "efficiency in lookups vs ratio", eff),
+            ("eff_time", "efficiency in time vs ratio", eff))
     t = ["| estimator | " + " | ".join("%s (%s)" % (c[1], head) for c in cols) + " |", "|---" * (1 + len(cols)) + "|"]
     for nm in dict.fromkeys(r["estimator"] for r in rows):
-        t.append("| %s | " % label(nm) + " | ".join(", ".join(c[2] % float(at[sc, nm][c[0]]) for sc in scenes)
+        t.append("| %s | " % label(nm) + " | ".join(", ".join(fmt(c[2], float(at[sc, nm][c[0]])) for sc in scenes)
                                                    for c in cols) + " |")
     t += ["", "`bench/transmittance %s %s`: %s segments per scene, %s estimates per segment%s.\nFor `raymarch` "
           "the efficiency is that of one estimate; its error floor is below." % (
@@ -128,8 +137,12 @@ def tables(rows, nseg, nest, mean_t):
             c = max("rgb", key=lambda c: float(r["bias2_" + c]))
             b2, var = float(r["bias2_" + c]), float(r["var_" + c])
             # bias^2 at most half the variance of the mean of the estimates is within the measurement's noise
-            cells.append("≤ %s (at the measurement's noise)" % sci(b2 ** 0.5, "%.0e") if b2 <= 0.5 * var / float(nest)
-                         else sci(b2 ** 0.5))
+            if b2 == 0:  # the measured bias² was below the noise of its estimate: transmittance.c clamps it
+                cells.append("0 (below the measurement's noise)")
+            elif b2 <= 0.5 * var / float(nest):
+                cells.append("≤ %s (at the measurement's noise)" % sci(b2 ** 0.5, "%.0e"))
+            else:
+                cells.append(sci(b2 ** 0.5))
         f.append("| %s | %s |" % (nm.split("_", 1)[1], " | ".join(cells)))
     return "\n".join(t), "\n".join(f)
 
