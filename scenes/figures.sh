@@ -75,11 +75,15 @@ e2() { awk -v x="$1" 'BEGIN { s = sprintf("%.2e", x); sub(/e-0/, "e-", s); sub(/
 # splice NAME : standard input into DOCS/gallery.md's block NAME
 splice() { "$PYTHON" tools/mdsplice.py "$DOCS/gallery.md" "$1" scenes/figures.sh; }
 
-# renders_table NAME... : a Markdown table of the renders NAME (scenes/NAME.yaml) from their stats
+# renders_table NAME... : a Markdown table of the renders NAME (scenes/NAME.yaml) from their stats (with
+# REUSE=1, stats written before they held the size and load: the size from the log, the load not recorded)
 renders_table() {
   echo "| scene | size | spp | seconds | load average before–after |"; echo "|---|---|---|---|---|"
   for name in "$@"; do
-    awk -v s="$name" '{ printf "| `scenes/%s.yaml` | %s | %s | %s | %s–%s |\n", s, $3, $1, $2, $4, $5 }' "$OUT/$name.stats"
+    awk -v s="$name" -v lg="$OUT/$name.log" '{ size = $3
+      while (size == "" && (getline l < lg) > 0) if (match(l, /: [0-9]+x[0-9]+, /)) size = substr(l, RSTART + 2, RLENGTH - 4)
+      printf "| `scenes/%s.yaml` | %s | %s | %s | %s |\n", s, size, $1, $2, ($5 == "" ? "not recorded" : $4 "–" $5) }' \
+      "$OUT/$name.stats"
   done
 }
 
