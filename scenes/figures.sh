@@ -119,7 +119,7 @@ figure2() {
     "$OUT/bunny_delta.png:$(caption bunny_delta 'delta tracking')" \
     "$OUT/bunny_diff.png:|control 0 - delta|, relMSE $rel\\nwhite = $white (99th percentile)"
   printf 'The strip: %s, %s spp (control 0) and %s spp (delta); control 0 against delta: relMSE %s, mean abs\nrel %s, the white of the difference image (its 99th percentile of |control 0 − delta|) %s.\n' \
-    "$(cut -d' ' -f3 "$OUT/bunny_control0.stats")" "$(cut -d' ' -f1 "$OUT/bunny_control0.stats")" \
+    "${RES}x$RES" "$(cut -d' ' -f1 "$OUT/bunny_control0.stats")" \
     "$(cut -d' ' -f1 "$OUT/bunny_delta.stats")" \
     "$(e2 "$rel")" "$(e2 "$absrel")" "$(e2 "$white")" | splice "fig2 numbers"
 }
