@@ -26,8 +26,9 @@
 # every PNG carries the commit of the tree as built: murk's PNG writer and the chart scripts write the text
 # keys murk:commit and murk:version (`murk info FILE.png`). Times are murk's own render times; the timed
 # figures (Figure 4, glass, bench) and the gallery's renders record the load average beside them. A fresh
-# clone at --scale 1 takes hours on 2 cores (the stability atlas alone tens of minutes; see docs/README.md
-# for measured times).
+# clone at --scale 1 takes over an hour on 2 cores (docs/README.md gives the measured times). Environment:
+# BENCH_ONLY="PATTERN ..." limits the bench part to the runs whose names match (e.g. 'e_* k*'), for
+# re-running a few; BUILD (default build), MURK, PYTHON, NO_BUILD=1 (skip ninja).
 set -eu
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -37,7 +38,7 @@ while [ $# -gt 0 ]; do
     --scale) SCALE=$2; shift 2 ;;
     --docs) DOCS=$2; shift 2 ;;
     --out) OUT=$2; shift 2 ;;
-    -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,31p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "docs.sh: unknown option $1" >&2; exit 2 ;;
     *) break ;;
   esac
@@ -105,6 +106,15 @@ part_stability() {
 # each argument is passed on as one word (a --set value may hold spaces)
 bench() {
   name=$1 scene=$2; shift 2
+  # BENCH_ONLY="PATTERN ...": only the runs whose name matches one of the shell patterns (default: all)
+  if [ -n "${BENCH_ONLY:-}" ]; then
+    keep=0
+    for pat in $BENCH_ONLY; do
+      # shellcheck disable=SC2254  # the pattern is meant to match
+      case $name in $pat) keep=1 ;; esac
+    done
+    [ "$keep" = 1 ] || return 0
+  fi
   left=$#
   while [ "$left" -gt 0 ]; do   # rotate the arguments through "$@", scaling the budgets on the way
     a=$1; shift; left=$((left - 1))
