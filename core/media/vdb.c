@@ -60,9 +60,9 @@ static void vdb_load_module(void)
             memcpy(&vdb_read, &fn, sizeof fn); /* ISO C has no object-to-function pointer cast */
             return;
         }
-        const char *why = h ? "it has no murk_vdb_read" : dlerror();
-        int k = snprintf(vdb_load_error + used, sizeof vdb_load_error - used, "%s%s", used ? "; " : "",
-                         why ? why : tried[i]);
+        const char *why = h ? "has no murk_vdb_read" : dlerror(); /* dlerror() names the file */
+        int k = snprintf(vdb_load_error + used, sizeof vdb_load_error - used, "%s%s%s%s", used ? "; " : "",
+                         h || !why ? tried[i] : "", h || !why ? ": " : "", why ? why : "cannot be loaded");
         if (k > 0)
             used += (size_t)k < sizeof vdb_load_error - used ? (size_t)k : sizeof vdb_load_error - 1 - used;
     }
