@@ -59,6 +59,8 @@ MURK_COMMIT=$("$MURK" --version | sed -n 's/.*(commit \([^,]*\),.*/\1/p')
 MURK_VERSION=$("$MURK" --version | awk '{print $2}')
 export MURK_COMMIT MURK_VERSION
 touch "$OUT/.start"
+: > "$OUT/walltime.txt"
+LOAD0=$(cut -d' ' -f1-3 /proc/loadavg)
 echo "docs.sh: murk $MURK_VERSION, commit $MURK_COMMIT; scale $SCALE; docs into $DOCS; renders into $OUT"
 
 n() { awk -v n="$1" -v s="$SCALE" -v m="${2:-1}" 'BEGIN { v = int(n * s + 0.5); print (v < m ? m : v) }'; }
@@ -224,4 +226,21 @@ done
 # every PNG written must say which build made it
 missing=$(find "$DOCS" -name '*.png' -newer "$OUT/.start" -exec sh -c '"$1" info "$2" | grep -q "^murk:commit: " || echo "$2"' _ "$MURK" {} \;)
 [ -z "$missing" ] || { echo "docs.sh: PNGs without murk:commit:"; echo "$missing"; exit 1; }
+# a whole run at the docs' counts writes its own times into docs/README.md ("How long")
+if [ "$PARTS" = "gallery figures glass transmittance stability bench page" ] && [ "$SCALE" = 1 ]; then
+  refs=$("$PYTHON" -c 'import glob, json, os, sys
+t = [json.load(open(f)).get("reference", {}) for f in glob.glob(sys.argv[1] + "/results/bench/*/bench.json")
+     if os.path.getmtime(f) >= os.path.getmtime(sys.argv[2])]
+print("%.0f %d %d" % (sum(r.get("seconds", 0) for r in t), sum(1 for r in t if r.get("seconds", 0) > 0), len(t)))' \
+    "$DOCS" "$OUT/.start")
+  awk -v c="$MURK_COMMIT" -v v="$MURK_VERSION" -v d="$(date -u +%Y-%m-%d)" -v n="$(nproc)" -v l0="$LOAD0" \
+      -v l1="$(cut -d' ' -f1-3 /proc/loadavg)" -v refs="$refs" '
+    { part[NR] = $2; sec[NR] = $4; total += $4 }
+    END {
+      split(refs, r, " ")
+      printf "The last whole run: `tools/docs.sh` at commit %s (murk %s), %s, %d cores, load average (1, 5, 15 min) %s at the start and %s at the end: ", c, v, d, n, l0, l1
+      for (i = 1; i <= NR; i++) printf "%s %d s%s", part[i], sec[i], i < NR ? ", " : ""
+      printf "; **%d s in all** (%d h %02d min). murk bench rendered the references of %d of its %d runs, %d s in all (the others reused one from its cache).\n", total, total / 3600, (total % 3600) / 60, r[2], r[3], r[1]
+    }' "$OUT/walltime.txt" | "$PYTHON" tools/mdsplice.py "$DOCS/README.md" "docs timing" tools/docs.sh
+fi
 echo "docs.sh: done (murk $MURK_VERSION, commit $MURK_COMMIT)"
