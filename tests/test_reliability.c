@@ -133,8 +133,9 @@ static void t_camera_far(void **state)
 
 /* host.c hands Embree only rays it can carry (Embree asserts, SIGABRT, on an origin or direction beyond
  * about 1.8e18 or not finite, a NaN or negative tnear, a NaN tfar). The check runs on every ray, so it is
- * two SSE compares: here against its scalar statement on the edge values of each of the 8 floats, through
- * the host's intersect() and occluded(). A refused ray is not traced (no hit, not occluded) nor counted. */
+ * one pass of SSE bound compares: here against its scalar statement on the edge values of each of the 8
+ * floats, through the host's intersect() and occluded(). A refused ray is not traced (no hit, not
+ * occluded) nor counted. */
 static int scalar_traceable(const murk_ray *r)
 {
     const float big = 1e18f;

@@ -125,18 +125,24 @@ _Static_assert(sizeof(murk_ray) == 8 * sizeof(float), "murk_ray is o, d, tmin, t
 static int ray_traceable(const murk_ray *r)
 {
 #if defined(__SSE2__)
-    /* the six coordinates as two vectors (murk_ray is 8 floats: o, d, tmin, tmax): |x| <= 1e18 is false
-     * for NaN, like the scalar test */
-    const __m128 big = _mm_set1_ps(1e18f), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    /* the ray as two vectors (murk_ray is 8 floats: o, d, tmin, tmax), each lane between a lower and an
+     * upper bound; every comparison is false for NaN, like the scalar test:
+     *   ox oy oz dx   in [-1e18, 1e18]  (|x| <= 1e18)
+     *   dy dz         in [-1e18, 1e18]
+     *   tmin          in [0, inf]       (tmin >= 0 and not NaN)
+     *   tmax          in [-inf, inf]    (not NaN) */
+    const __m128 lo_max = _mm_set1_ps(1e18f), lo_min = _mm_set1_ps(-1e18f);
+    const __m128 hi_max = _mm_setr_ps(1e18f, 1e18f, INFINITY, INFINITY);
+    const __m128 hi_min = _mm_setr_ps(-1e18f, -1e18f, 0.0f, -INFINITY);
     __m128 lo = _mm_loadu_ps(&r->o.x), hi = _mm_loadu_ps(&r->d.y); /* ox oy oz dx, dy dz tmin tmax */
-    int in = _mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(lo, abs), big)) == 0xf &&
-             (_mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(hi, abs), big)) & 3) == 3;
+    __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(lo_min, lo), _mm_cmple_ps(lo, lo_max)),
+                           _mm_and_ps(_mm_cmple_ps(hi_min, hi), _mm_cmple_ps(hi, hi_max)));
+    int ok = _mm_movemask_ps(in) == 0xf;
 #else
     const float big = 1e18f;
-    int in = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
-             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big;
+    int ok = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
+             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
 #endif
-    int ok = in && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
     if (!ok)
         murk_warn_once("a ray beyond the range Embree accepts (origin or direction beyond 1e18, or NaN) was not "
                        "traced: a path left the scene through an unbounded medium");
