@@ -426,9 +426,17 @@ def t_e3(R):
                           [RELMSE, LOOKUPS, EFF_T, EFF_L], "nee_mis")
 
 
+def t_w(R):
+    return variants_block(R["w_cornell_smoke_shadow_rays"], "transmittance=residual_ratio",
+                          [("transmittance=%s" % t, t + (" (default)" if t == "residual_ratio" else "")) for t in
+                           ("residual_ratio", "ratio", "unbiased_raymarch")],
+                          [RELMSE, LOOKUPS, EFF_T, EFF_L], "shadow-ray estimator")
+
+
 TABLES = {"a": t_a, "b": t_b, "c": t_c, "d": t_d, "d2": t_d2, "lights_cloud_sun": t_lights_cloud_sun,
           "lights_spot_fog": t_lights_spot_fog, "k": t_k, "k_first": t_k_first, "m": t_m, "m_nee": t_m_nee,
-          "g2_steps": t_g2_steps, "g2_nee": t_g2_nee, "e": t_e, "e2": t_e2, "e3": t_e3}
+          "g2_steps": t_g2_steps, "g2_nee": t_g2_nee, "e": t_e, "e2": t_e2, "e3": t_e3,
+          "w": t_w}
 
 
 class Runs(dict):

@@ -185,6 +185,10 @@ part_bench() {
   bench m4_spectral_extinction_nee_mis_spp scenes/spectral_extinction.yaml \
     --vary integrator.nee_mis=solid_angle,null_scattering --set "$MREF" --set media.medium.transmittance=ratio \
     --set "$R64" --spp 16,64 --ref-spp 2048 --ref-set "$MREF"
+  # the transmittance section's whole images: three shadow-ray estimators on cornell_smoke at equal time
+  bench w_cornell_smoke_shadow_rays scenes/cornell_smoke.yaml \
+    --vary media.smoke.transmittance=residual_ratio,ratio,unbiased_raymarch --set 'render.resolution=[128,128]' \
+    --time 2,8 --ref-spp 512
   # h.: every tracker, shadow-ray estimator and NEE weighting on the explosion
   EREF='media.fire.type=spectral_mis'
   bench e_explosion_trackers scenes/explosion.yaml \
