@@ -154,7 +154,7 @@ static void t_ray_range(void **state)
         fail_msg("%s", err);
     const murk_host *h = murk_host_table();
     const float edge[] = {0.0f, -0.0f, 1e18f, -1e18f, nextafterf(1e18f, INFINITY), -nextafterf(1e18f, INFINITY),
-                          INFINITY, -INFINITY, NAN, -NAN, 1e-45f};
+                          INFINITY, -INFINITY, NAN, -NAN, 1e-45f, -1e-45f};
     int n = (int)(sizeof edge / sizeof edge[0]), checked = 0;
     for (int f = 0; f < 8; f++)
         for (int e = 0; e < n; e++) {
