@@ -133,8 +133,9 @@ static void t_camera_far(void **state)
 
 /* host.c hands Embree only rays it can carry (Embree asserts, SIGABRT, on an origin or direction beyond
  * about 1.8e18 or not finite, a NaN or negative tnear, a NaN tfar). The check runs on every ray, so it is
- * two SSE compares: here against its scalar statement on the edge values of each of the 8 floats, through
- * the host's intersect() and occluded(). A refused ray is not traced (no hit, not occluded) nor counted. */
+ * one pass of SSE bound compares: here against its scalar statement on the edge values of each of the 8
+ * floats, through the host's intersect() and occluded(). A refused ray is not traced (no hit, not
+ * occluded) nor counted. */
 static int scalar_traceable(const murk_ray *r)
 {
     const float big = 1e18f;
@@ -153,7 +154,7 @@ static void t_ray_range(void **state)
         fail_msg("%s", err);
     const murk_host *h = murk_host_table();
     const float edge[] = {0.0f, -0.0f, 1e18f, -1e18f, nextafterf(1e18f, INFINITY), -nextafterf(1e18f, INFINITY),
-                          INFINITY, -INFINITY, NAN, -NAN, 1e-45f};
+                          INFINITY, -INFINITY, NAN, -NAN, 1e-45f, -1e-45f};
     int n = (int)(sizeof edge / sizeof edge[0]), checked = 0;
     for (int f = 0; f < 8; f++)
         for (int e = 0; e < n; e++) {

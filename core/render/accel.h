@@ -8,9 +8,10 @@
 #include "scene/scene.h"
 
 /* Vertex i of a triangle shape. */
-static inline murk_vec3 murk_shape_vertex(const murk_shape *sh, uint32_t i)
+static inline murk_vec3 murk_shape_vertex(const murk_shape *sh, size_t i)
 {
-    return murk_v3(sh->pos[3 * i], sh->pos[3 * i + 1], sh->pos[3 * i + 2]);
+    const float *v = &sh->pos[3 * i]; /* size_t: one address, the three floats at constant offsets */
+    return murk_v3(v[0], v[1], v[2]);
 }
 
 /* The unit geometric normal of triangle (a, b, c): (b - a) x (c - a), normalised. accel.c stores it per

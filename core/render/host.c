@@ -69,22 +69,25 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
         h->u = 0.5f + atan2f(n.z, n.x) * (0.5f * MURK_INV_PI);
         h->v = acosf(murk_minf(1.0f, murk_maxf(-1.0f, n.y))) * MURK_INV_PI;
     } else {
-        const uint32_t *ix = &sh->idx[3 * h->prim];
+        /* the corners' indices read once, as size_t: each corner's floats are then one address plus a
+         * constant offset (no reloads after the stores to *h, no 32-bit index arithmetic per float) */
+        const uint32_t *ix = &sh->idx[3 * (size_t)h->prim];
+        const size_t i0 = ix[0], i1 = ix[1], i2 = ix[2];
         float b1 = rh->hit.u, b2 = rh->hit.v, b0 = 1.0f - b1 - b2;
-        murk_vec3 a = murk_shape_vertex(sh, ix[0]), b = murk_shape_vertex(sh, ix[1]), c = murk_shape_vertex(sh, ix[2]);
+        murk_vec3 a = murk_shape_vertex(sh, i0), b = murk_shape_vertex(sh, i1), c = murk_shape_vertex(sh, i2);
         h->p = murk_add(murk_add(murk_mul(a, b0), murk_mul(b, b1)), murk_mul(c, b2));
-        h->ng = sh->ng ? murk_v3(sh->ng[3 * h->prim], sh->ng[3 * h->prim + 1], sh->ng[3 * h->prim + 2])
-                       : murk_triangle_normal(a, b, c);
+        const float *ng = sh->ng ? &sh->ng[3 * (size_t)h->prim] : NULL;
+        h->ng = ng ? murk_v3(ng[0], ng[1], ng[2]) : murk_triangle_normal(a, b, c);
         h->n = h->ng;
         if (sh->nrm) {
-            const float *n0 = &sh->nrm[3 * ix[0]], *n1 = &sh->nrm[3 * ix[1]], *n2 = &sh->nrm[3 * ix[2]];
+            const float *n0 = &sh->nrm[3 * i0], *n1 = &sh->nrm[3 * i1], *n2 = &sh->nrm[3 * i2];
             murk_vec3 ns = murk_normalize(murk_v3(b0 * n0[0] + b1 * n1[0] + b2 * n2[0], b0 * n0[1] + b1 * n1[1] + b2 * n2[1],
                                                   b0 * n0[2] + b1 * n1[2] + b2 * n2[2]));
             if (murk_dot(ns, ns) > 0.5f)
                 h->n = murk_dot(ns, h->ng) < 0.0f ? murk_neg(ns) : ns;
         }
         if (sh->uv) {
-            const float *t0 = &sh->uv[2 * ix[0]], *t1 = &sh->uv[2 * ix[1]], *t2 = &sh->uv[2 * ix[2]];
+            const float *t0 = &sh->uv[2 * i0], *t1 = &sh->uv[2 * i1], *t2 = &sh->uv[2 * i2];
             h->u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
             h->v = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
         } else {
@@ -125,18 +128,24 @@ _Static_assert(sizeof(murk_ray) == 8 * sizeof(float), "murk_ray is o, d, tmin, t
 static int ray_traceable(const murk_ray *r)
 {
 #if defined(__SSE2__)
-    /* the six coordinates as two vectors (murk_ray is 8 floats: o, d, tmin, tmax): |x| <= 1e18 is false
-     * for NaN, like the scalar test */
-    const __m128 big = _mm_set1_ps(1e18f), abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    /* the ray as two vectors (murk_ray is 8 floats: o, d, tmin, tmax), each lane between a lower and an
+     * upper bound; every comparison is false for NaN, like the scalar test:
+     *   ox oy oz dx   in [-1e18, 1e18]  (|x| <= 1e18)
+     *   dy dz         in [-1e18, 1e18]
+     *   tmin          in [0, inf]       (tmin >= 0 and not NaN)
+     *   tmax          in [-inf, inf]    (not NaN) */
+    const __m128 lo_max = _mm_set1_ps(1e18f), lo_min = _mm_set1_ps(-1e18f);
+    const __m128 hi_max = _mm_setr_ps(1e18f, 1e18f, INFINITY, INFINITY);
+    const __m128 hi_min = _mm_setr_ps(-1e18f, -1e18f, 0.0f, -INFINITY);
     __m128 lo = _mm_loadu_ps(&r->o.x), hi = _mm_loadu_ps(&r->d.y); /* ox oy oz dx, dy dz tmin tmax */
-    int in = _mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(lo, abs), big)) == 0xf &&
-             (_mm_movemask_ps(_mm_cmple_ps(_mm_and_ps(hi, abs), big)) & 3) == 3;
+    __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmple_ps(lo_min, lo), _mm_cmple_ps(lo, lo_max)),
+                           _mm_and_ps(_mm_cmple_ps(hi_min, hi), _mm_cmple_ps(hi, hi_max)));
+    int ok = _mm_movemask_ps(in) == 0xf;
 #else
     const float big = 1e18f;
-    int in = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
-             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big;
+    int ok = fabsf(r->o.x) <= big && fabsf(r->o.y) <= big && fabsf(r->o.z) <= big && fabsf(r->d.x) <= big &&
+             fabsf(r->d.y) <= big && fabsf(r->d.z) <= big && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
 #endif
-    int ok = in && r->tmin >= 0.0f && r->tmin <= INFINITY && !isnan(r->tmax);
     if (!ok)
         murk_warn_once("a ray beyond the range Embree accepts (origin or direction beyond 1e18, or NaN) was not "
                        "traced: a path left the scene through an unbounded medium");
