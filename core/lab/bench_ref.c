@@ -56,8 +56,10 @@ int murk_bench_read_exr(const char *path, int w, int h, float **out)
 /* Renders the reference in REF_CHUNKS independent chunks (seeds 900001..): the mean of the chunks is the
  * reference and the variance of its per-pixel mean is estimated without bias from the chunks' spread,
  * s^2 / REF_CHUNKS (s^2 the chunks' sample variance). Cached under the content hash of the scene file and
- * of every file it loads, the --set overrides, the spp and murk's version: the mean and the variance as
- * one group of atomic writes (both files or neither). A stop signal abandons it (-1, nothing cached). */
+ * of every file it loads, the --set overrides, the spp, murk's version and the commit it was built from
+ * (so a build that renders differently never compares against an older build's reference; a build with
+ * uncommitted edits, "-dirty", shares the key of its commit): the mean and the variance as one group of
+ * atomic writes (both files or neither). A stop signal abandons it (-1, nothing cached). */
 int murk_bench_reference(const bench *b, reference *r)
 {
     char err[2048], dir[3072];
@@ -76,6 +78,7 @@ int murk_bench_reference(const bench *b, reference *r)
     }
     uint64_t h = fnv(1469598103934665603ull, "murk bench reference 1", 23);
     h = fnv(h, MURK_VERSION, sizeof MURK_VERSION);
+    h = fnv(h, murk_build_commit(), strlen(murk_build_commit()) + 1);
     h = fnv(h, &sh, sizeof sh);
     h = fnv(h, &b->ref_spp, sizeof b->ref_spp);
     for (size_t i = 0; i < n; i++)

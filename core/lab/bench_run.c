@@ -348,7 +348,7 @@ static int load_reference(const bench *b, reference *r)
         return murk_cli_stop_status();
     }
     if (r->reused)
-        printf("reference: %s (reused from the cache: same scene file, --set, spp and murk version)\n",
+        printf("reference: %s (reused from the cache: same scene file, --set, spp, murk version and commit)\n",
                murk_cli_q(r->path));
     else
         printf("reference: %s (rendered: %d spp in %d chunks, %.1f s; cached)\n", murk_cli_q(r->path),
