@@ -43,7 +43,8 @@ while [ $# -gt 0 ]; do
     *) break ;;
   esac
 done
-PARTS=${*:-gallery figures glass transmittance stability bench page}
+ALL_PARTS="gallery figures glass transmittance stability bench page"
+PARTS=${*:-$ALL_PARTS}
 BUILD=${BUILD:-build}
 MURK=${MURK:-$ROOT/$BUILD/core/murk}
 PYTHON=${PYTHON:-/usr/bin/python3}
@@ -226,8 +227,8 @@ done
 # every PNG written must say which build made it
 missing=$(find "$DOCS" -name '*.png' -newer "$OUT/.start" -exec sh -c '"$1" info "$2" | grep -q "^murk:commit: " || echo "$2"' _ "$MURK" {} \;)
 [ -z "$missing" ] || { echo "docs.sh: PNGs without murk:commit:"; echo "$missing"; exit 1; }
-# a whole run at the docs' counts writes its own times into docs/README.md ("How long")
-if [ "$PARTS" = "gallery figures glass transmittance stability bench page" ] && [ "$SCALE" = 1 ]; then
+# a whole run at the docs' counts (every part, every bench run) writes its own times into docs/README.md
+if [ "$PARTS" = "$ALL_PARTS" ] && [ "$SCALE" = 1 ] && [ -z "${BENCH_ONLY:-}" ]; then
   refs=$("$PYTHON" -c 'import glob, json, os, sys
 t = [json.load(open(f)).get("reference", {}) for f in glob.glob(sys.argv[1] + "/results/bench/*/bench.json")
      if os.path.getmtime(f) >= os.path.getmtime(sys.argv[2])]
