@@ -2,6 +2,7 @@
 scripts: scanline images of R, G, B (or Y) channels, HALF or FLOAT, compression NONE, ZIPS or ZIP.
 
     read(path)  -> numpy float32 array (h, w, 3), row 0 at the top
+    meta(path)  -> dict of the string attributes (murk:nonfinite_samples, murk:seed, ...)
     write(path, rgb, half=True, zip=True)   writes R, G, B; ZIP (16 lines a chunk), deterministic bytes
 
 The format (OpenEXR's "Technical Introduction" and file layout document): magic 20000630, version 2,
@@ -66,13 +67,24 @@ def _channels(value):
     return chans
 
 
-def read(path):
-    """An (h, w, 3) float32 array of a scanline EXR's R, G, B (or Y copied to all three)."""
+def _header(path):
     buf = open(path, "rb").read()
     magic, version = struct.unpack_from("<ii", buf, 0)
     if magic != MAGIC or version & 0x200 or version & 0x1000:
         raise ValueError("%s: not a single-part scanline EXR" % path)
     attrs, pos = _attrs(buf, 8)
+    return buf, attrs, pos
+
+
+def meta(path):
+    """A scanline EXR's string attributes as a dict of str (murk's murk:* metadata among them)."""
+    _, attrs, _ = _header(path)
+    return {k: v.decode(errors="replace") for k, (t, v) in attrs.items() if t == "string"}
+
+
+def read(path):
+    """An (h, w, 3) float32 array of a scanline EXR's R, G, B (or Y copied to all three)."""
+    buf, attrs, pos = _header(path)
     chans = _channels(attrs["channels"][1])
     comp = attrs["compression"][1][0]
     if comp not in LINES:
