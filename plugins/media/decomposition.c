@@ -77,7 +77,7 @@ static MURK_ALWAYS_INLINE float decomposition_depth(murk_rng *rng, int *first, f
         *carried = -1.0f;
     } else {
         carry = *first && rng->sampler == MURK_SAMPLER_SOBOL;
-        tau = -log1pf(-murk_flight_float(rng, first, uc));
+        tau = murk_exp1(murk_flight_float(rng, first, uc));
     }
     *keep = carry ? murk_maxf(tau, 1e-30f) : 0.0f;
     return tau;

@@ -67,7 +67,7 @@ static int smis_closed_form(const murk_tracker *m, const murk_ray *ray, const mu
             return 0;
         }
         if (tau < 0.0f)
-            tau = -log1pf(-murk_flight_float(rng, first, &uc));
+            tau = murk_exp1(murk_flight_float(rng, first, &uc));
         float sh = dmax * m->sigma_t.c[hero], len = b - a;
         float x = sh > 0.0f ? tau / sh : INFINITY;
         tau -= sh * len;

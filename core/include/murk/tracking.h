@@ -90,8 +90,15 @@ static inline void murk_event_init(murk_medium_event *ev, const murk_ray *ray)
 /* Extinction per unit density. */
 static inline murk_rgb murk_sigma_t(const murk_medium_data *d) { return murk_rgb_add(d->sigma_a, d->sigma_s); }
 
+/* The Exp(1) variate -ln(1 - u) of a uniform u in [0, 1): an optical depth. murk's uniforms
+ * (murk_rng_float, murk_sample_1d/2d) are multiples of 2^-24, so 1 - u is exact in float and logf(1 - u)
+ * is as accurate as log1pf(-u), at a fraction of glibc's log1pf's cost (docs/results.md, "Free-flight
+ * logarithm"); for any other u in [0, 1) the rounding of 1 - u moves the result by at most 2^-24. Every
+ * free flight and tentative collision draws one. */
+static MURK_ALWAYS_INLINE float murk_exp1(float u) { return -logf(1.0f - u); }
+
 /* Distance to the next event of a Poisson process of rate mu > 0. */
-static inline float murk_sample_exp(murk_rng *rng, float mu) { return -log1pf(-murk_rng_float(rng)) / mu; }
+static inline float murk_sample_exp(murk_rng *rng, float mu) { return murk_exp1(murk_rng_float(rng)) / mu; }
 
 /* Stratified free flights (the medium's `stratify_flights` key, murk_medium_data.stratify_flights). The
  * integrator seeks (murk_sample_seek) to a slot of the flight's own before sample(); a stratified flight
@@ -128,7 +135,7 @@ static MURK_ALWAYS_INLINE float murk_flight_float(murk_rng *rng, int *first, flo
 /* murk_sample_exp with murk_flight_float's number. */
 static inline float murk_flight_exp(murk_rng *rng, int *first, float *uc, float mu)
 {
-    return -log1pf(-murk_flight_float(rng, first, uc)) / mu;
+    return murk_exp1(murk_flight_float(rng, first, uc)) / mu;
 }
 
 /* The number for a collision's choice: the slot's second coordinate if murk_flight_float left one in
@@ -297,7 +304,7 @@ static MURK_ALWAYS_INLINE int murk_collisions_next(murk_collisions *c, murk_rng 
                 tau = c->tau;
             } else {
                 carry = c->first && rng->sampler == MURK_SAMPLER_SOBOL;
-                tau = -log1pf(-murk_flight_float(rng, &c->first, &c->uc));
+                tau = murk_exp1(murk_flight_float(rng, &c->first, &c->uc));
             }
             c->t = murk_advance(c->t, tau / c->mu);
             c->tau = carry && !(c->t < c->tb) ? murk_fmaxf(0.0f, tau - c->mu * (c->tb - t0)) : -1.0f;
