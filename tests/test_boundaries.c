@@ -13,6 +13,12 @@
  *               0) occluded() alone, with them the first leg's intersect() alone; the Cornell box renders
  *               bitwise what it renders with an index-matched box out of every ray's reach added, with as
  *               many rays.
+ *   empty_box   a medium box with nothing else inside (render/accel.h) is found, and one that a sphere,
+ *               a touching quad or a nested box meets is not; from inside it the host answers intersect()
+ *               and occluded() by a slab test, with no Embree ray (the thread's ray count stays put), and
+ *               agrees with Embree on 20000 random rays: the same face, t and p within 2e-5, the same
+ *               normal, medium and answer for shortened rays; rays from outside go to Embree. Must-fail:
+ *               the box declared empty in the scene with the sphere inside hides the sphere.
  * In the suite 'long' (long_* tests, 32x32, 8 seeds, 8x8-pixel blocks: 16 blocks, each with the
  * samples of test_boundaries_long's 64x64 blocks, at a quarter of its cost: a block's standard error is
  * about 0.1 % of its value):
@@ -36,6 +42,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "render/accel.h"
 #include "render/host.h"
 #include "pathtracer.h"
 #include "scene/scene.h"
@@ -349,11 +356,136 @@ static void test_shadow_once(void **state)
     assert_true(plain == bounded);
 }
 
+/* ---- empty medium boxes ------------------------------------------------------------------------- */
+
+static murk_scene *ebox_load(const char *extra)
+{
+    char text[2048], err[1024];
+    snprintf(text, sizeof text,
+             "murk: 1\n"
+             "materials: { white: { type: diffuse, albedo: 0.5 } }\n"
+             "media: { m: { type: delta, density: { constant: 1 }, sigma_a: 0.1, sigma_s: 0.5 } }\n"
+             "shapes:\n"
+             "  - { type: quad, center: [0, 0, 0], u: [0, 0, 1], v: [1, 0, 0], material: white }\n"
+             "  - { type: box, min: [-0.6, 0.1, -0.5], max: [0.7, 1.3, 0.4], interior: m }\n%s",
+             extra);
+    murk_scene *s = murk_scene_load(write_tmp("ebox.yaml", text), NULL, 0, err, sizeof err);
+    if (!s)
+        fail_msg("%s", err);
+    return s;
+}
+
+static murk_vec3 uniform_dir(murk_rng *rng)
+{
+    float z = 1.0f - 2.0f * murk_rng_float(rng), phi = 2.0f * MURK_PI * murk_rng_float(rng);
+    float r = sqrtf(murk_maxf(0.0f, 1.0f - z * z));
+    return murk_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+/* Whether the host's answers for r with the scene's empty boxes equal Embree's alone (boxes switched off);
+ * *shortcut gets 1 if the first answer traced no Embree ray. Prints the first disagreement. */
+static int ebox_agrees(murk_scene *s, const murk_ray *r, int *shortcut)
+{
+    const murk_host *h = murk_host_table();
+    murk_hit a, b;
+    uint64_t before = murk_host_thread_rays();
+    int fa = h->intersect(s, r, &a), oa = h->occluded(s, r);
+    *shortcut = murk_host_thread_rays() == before;
+    size_t n = s->nempty_boxes;
+    s->nempty_boxes = 0;
+    int fb = h->intersect(s, r, &b), ob = h->occluded(s, r);
+    s->nempty_boxes = n;
+    int ok = fa == fb && oa == ob;
+    if (ok && fa) {
+        float tol = 2e-5f * murk_maxf(1.0f, b.t);
+        ok = a.geom == b.geom && fabsf(a.t - b.t) <= tol && murk_length(murk_sub(a.p, b.p)) <= tol &&
+             murk_dot(a.ng, b.ng) == 1.0f && a.interior == b.interior && a.exterior == b.exterior &&
+             a.material == b.material && a.light == b.light;
+    }
+    if (!ok)
+        printf("  ray (%g %g %g) -> (%g %g %g), tmax %g: host %d/%d geom %u t %.7g, Embree %d/%d geom %u t %.7g\n",
+               (double)r->o.x, (double)r->o.y, (double)r->o.z, (double)r->d.x, (double)r->d.y, (double)r->d.z,
+               (double)r->tmax, fa, oa, fa ? a.geom : 0u, fa ? (double)a.t : 0.0, fb, ob, fb ? b.geom : 0u,
+               fb ? (double)b.t : 0.0);
+    return ok;
+}
+
+static void test_empty_box(void **state)
+{
+    (void)state;
+    /* the scene's box is shape 1; first: the first empty box's shape (-1: none) */
+    static const struct { const char *label, *extra; size_t boxes; int first; } found[] = {
+        {"alone", "", 1, 1},
+        {"a sphere inside", "  - { type: sphere, center: [0, 0.7, 0], radius: 0.1, material: white }\n", 0, -1},
+        {"a quad touching its face", "  - { type: quad, center: [0, 0.1, 0], u: [0, 0, 0.2], v: [0.2, 0, 0], "
+                                     "material: white }\n", 0, -1},
+        {"a quad 1e-5 below its face", "  - { type: quad, center: [0, 0.09999, 0], u: [0, 0, 0.2], v: [0.2, 0, 0], "
+                                       "material: white }\n", 0, -1},
+        {"a medium box nested in it (itself empty)", "  - { type: box, min: [0, 0.5, 0], max: [0.2, 0.7, 0.2], "
+                                                     "interior: m }\n", 1, 2},
+        {"an opaque box beside it", "  - { type: box, min: [0.8, 0, 0], max: [0.9, 0.2, 0.1], material: white }\n", 1, 1},
+        {"a second medium box beside it", "  - { type: box, min: [0.8, 0.05, 0], max: [0.9, 0.2, 0.1], interior: m }\n",
+         2, 1},
+    };
+    for (size_t i = 0; i < sizeof found / sizeof found[0]; i++) {
+        murk_scene *s = ebox_load(found[i].extra);
+        int first = s->nempty_boxes ? (int)s->empty_boxes[0].geom : -1;
+        printf("box %s: %zu empty medium boxes, the first shape %d (expected %zu, %d)\n", found[i].label,
+               s->nempty_boxes, first, found[i].boxes, found[i].first);
+        assert_int_equal(s->nempty_boxes, found[i].boxes);
+        assert_int_equal(first, found[i].first);
+        murk_scene_free(s);
+    }
+    murk_scene *s = ebox_load("");
+    murk_rng rng;
+    murk_rng_seed(&rng, 7, 1, 2);
+    int bad = 0, shortcuts = 0, outside = 0;
+    const int N = 20000;
+    for (int i = 0; i < N; i++) {
+        /* origins over a slightly larger box: most inside (shortcut), some outside (Embree) */
+        murk_vec3 o = murk_v3(-0.65f + 1.4f * murk_rng_float(&rng), 0.05f + 1.3f * murk_rng_float(&rng),
+                              -0.55f + 1.0f * murk_rng_float(&rng));
+        murk_ray r = {o, uniform_dir(&rng), 0.0f, INFINITY};
+        int sc;
+        bad += !ebox_agrees(s, &r, &sc);
+        shortcuts += sc;
+        murk_hit hit;
+        if (murk_host_table()->intersect(s, &r, &hit)) { /* shortened: ends before the hit, or just past it */
+            r.tmax = 0.5f * hit.t;
+            bad += !ebox_agrees(s, &r, &sc);
+            r.tmax = 1.5f * hit.t;
+            bad += !ebox_agrees(s, &r, &sc);
+        }
+        outside += !(o.x >= -0.6f && o.x <= 0.7f && o.y >= 0.1f && o.y <= 1.3f && o.z >= -0.5f && o.z <= 0.4f);
+    }
+    printf("empty box: %d rays (%d from outside it), %d answered without Embree, %d disagreements\n", N, outside,
+           shortcuts, bad);
+    assert_int_equal(bad, 0);
+    assert_true(shortcuts == N - outside);
+    /* must fail: the same box declared empty where a sphere sits inside hides the sphere from a ray aimed
+     * at it (the detection above is what prevents this) */
+    murk_scene *t = ebox_load("  - { type: sphere, center: [0, 0.7, 0], radius: 0.1, material: white }\n");
+    assert_int_equal(t->nempty_boxes, 0);
+    murk_empty_box wrong = s->empty_boxes[0];
+    t->empty_boxes = &wrong;
+    t->nempty_boxes = 1;
+    murk_ray at_sphere = {murk_v3(0.5f, 0.7f, 0.0f), murk_v3(-1.0f, 0.0f, 0.0f), 0.0f, INFINITY};
+    int sc;
+    int agrees = ebox_agrees(t, &at_sphere, &sc);
+    printf("must fail: a box wrongly declared empty around a sphere %s\n", agrees ? "went unnoticed" : "is seen");
+    assert_false(agrees);
+    t->empty_boxes = NULL;
+    t->nempty_boxes = 0;
+    murk_scene_free(t);
+    murk_scene_free(s);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shadow),
         cmocka_unit_test(test_shadow_once),
+        cmocka_unit_test(test_empty_box),
         cmocka_unit_test(long_nee),
         cmocka_unit_test(long_path),
     };

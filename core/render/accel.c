@@ -5,6 +5,7 @@
 #include "util/runtime.h"
 #include "util/util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,70 @@ static bool embree_memory(void *user, ssize_t bytes, bool post)
     (void)post;
     __atomic_fetch_add(&((murk_scene *)user)->embree_bytes, (long long)bytes, __ATOMIC_RELAXED);
     return true;
+}
+
+/* The bounds of triangle t of shape sh, or of a sphere (t ignored). */
+static void prim_bounds(const murk_shape *sh, uint32_t t, murk_vec3 *lo, murk_vec3 *hi)
+{
+    if (sh->type == MURK_SHAPE_SPHERE) {
+        murk_vec3 r = murk_v3(sh->radius, sh->radius, sh->radius);
+        *lo = murk_sub(sh->center, r);
+        *hi = murk_add(sh->center, r);
+        return;
+    }
+    const uint32_t *tv = &sh->idx[3 * t];
+    *lo = *hi = murk_shape_vertex(sh, tv[0]);
+    for (int k = 1; k < 3; k++) {
+        murk_vec3 v = murk_shape_vertex(sh, tv[k]);
+        *lo = murk_v3(murk_minf(lo->x, v.x), murk_minf(lo->y, v.y), murk_minf(lo->z, v.z));
+        *hi = murk_v3(murk_maxf(hi->x, v.x), murk_maxf(hi->y, v.y), murk_maxf(hi->z, v.z));
+    }
+}
+
+static int boxes_meet(murk_vec3 alo, murk_vec3 ahi, murk_vec3 blo, murk_vec3 bhi)
+{
+    return alo.x <= bhi.x && blo.x <= ahi.x && alo.y <= bhi.y && blo.y <= ahi.y && alo.z <= bhi.z && blo.z <= ahi.z;
+}
+
+/* Box shape i as an empty medium box (accel.h), or 0: it holds no medium, something else meets it, or
+ * its faces are not two triangles each with axis-aligned normals. "Meets" uses the box grown by 1e-4 of
+ * its coordinates' magnitude (the integrators' offset off a surface): a shape on or within rounding of a
+ * face could tie with the face or beat it in Embree's arithmetic, so such a box is left to Embree. */
+static int empty_box(const murk_scene *s, size_t i, murk_empty_box *b)
+{
+    const murk_shape *sh = &s->shapes[i];
+    if (sh->type != MURK_SHAPE_BOX || !sh->interior || sh->ntris != 12)
+        return 0;
+    b->lo = b->hi = murk_shape_vertex(sh, 0);
+    for (uint32_t v = 1; v < sh->nverts; v++) {
+        murk_vec3 p = murk_shape_vertex(sh, v);
+        b->lo = murk_v3(murk_minf(b->lo.x, p.x), murk_minf(b->lo.y, p.y), murk_minf(b->lo.z, p.z));
+        b->hi = murk_v3(murk_maxf(b->hi.x, p.x), murk_maxf(b->hi.y, p.y), murk_maxf(b->hi.z, p.z));
+    }
+    float m = 1e-4f * murk_maxf(1.0f, murk_maxf(murk_maxf(fabsf(b->lo.x), fabsf(b->lo.y)),
+                                                 murk_maxf(murk_maxf(fabsf(b->lo.z), fabsf(b->hi.x)),
+                                                           murk_maxf(fabsf(b->hi.y), fabsf(b->hi.z)))));
+    murk_vec3 glo = murk_sub(b->lo, murk_v3(m, m, m)), ghi = murk_add(b->hi, murk_v3(m, m, m));
+    for (size_t j = 0; j < s->nshapes; j++) {
+        const murk_shape *o = &s->shapes[j];
+        for (uint32_t t = 0; j != i && t < (o->type == MURK_SHAPE_SPHERE ? 1u : o->ntris); t++) {
+            murk_vec3 lo, hi;
+            prim_bounds(o, t, &lo, &hi);
+            if (boxes_meet(lo, hi, glo, ghi))
+                return 0;
+        }
+    }
+    int n[6] = {0};
+    b->geom = (uint32_t)i;
+    for (uint32_t t = 0; t < 12; t++) {
+        const float *g = &sh->ng[3 * t];
+        int a = fabsf(g[0]) > 0.5f ? 0 : (fabsf(g[1]) > 0.5f ? 1 : 2);
+        int f = 2 * a + (g[a] > 0.0f ? 0 : 1);
+        if (g[(a + 1) % 3] != 0.0f || g[(a + 2) % 3] != 0.0f || n[f] == 2) /* not axis-aligned */
+            return 0;
+        b->face_tri[f][n[f]++] = t;
+    }
+    return 1;
 }
 
 int murk_accel_build(murk_scene *s, char *err, size_t errlen)
@@ -83,6 +148,17 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
     if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
         murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
         return -1;
+    }
+    free(s->empty_boxes);
+    s->empty_boxes = NULL;
+    s->nempty_boxes = 0;
+    murk_empty_box b;
+    for (size_t i = 0; i < s->nshapes && s->nempty_boxes < MURK_EMPTY_BOX_MAX; i++) {
+        if (!empty_box(s, i, &b))
+            continue;
+        if (!s->empty_boxes)
+            s->empty_boxes = murk_xmalloc(MURK_EMPTY_BOX_MAX * sizeof *s->empty_boxes);
+        s->empty_boxes[s->nempty_boxes++] = b;
     }
     return 0;
 }

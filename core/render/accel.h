@@ -21,7 +21,19 @@ static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3
     return murk_normalize(murk_cross(murk_sub(b, a), murk_sub(c, a)));
 }
 
-/* Returns 0, or -1 with err = "scene.yaml: what went wrong". */
+/* A box shape holding a medium (interior set) and nothing else: no other shape's bounds meet the closed
+ * box. A ray that starts inside it meets one of its faces before anything else, so host.c finds that
+ * face by a slab test instead of asking Embree — the free flights and shadow rays from the scattering
+ * events of a medium in a box, the commonest medium setup, cost no traversal. At most
+ * MURK_EMPTY_BOX_MAX per scene (each costs every ray an inside test). */
+enum { MURK_EMPTY_BOX_MAX = 8 };
+typedef struct murk_empty_box {
+    murk_vec3 lo, hi;
+    uint32_t geom;           /* the shape's index (its Embree geometry id) */
+    uint32_t face_tri[6][2]; /* the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
+} murk_empty_box;
+
+/* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium boxes. */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 
 #endif

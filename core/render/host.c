@@ -152,10 +152,85 @@ static int ray_traceable(const murk_ray *r)
     return ok;
 }
 
+/* A ray from inside an empty medium box (accel.h): the box, the distance *t to where the ray leaves it
+ * and the face it leaves by (2a for the +a side, 2a + 1 for -a); NULL when no such box holds the origin,
+ * or when the exit lies at or before tmin (a ray leaving from a face): Embree decides then. */
+static const murk_empty_box *box_exit(const murk_scene *s, const murk_ray *r, float *t, int *face)
+{
+    for (size_t i = 0; i < s->nempty_boxes; i++) {
+        const murk_empty_box *b = &s->empty_boxes[i];
+        const murk_vec3 o = r->o;
+        if (!(o.x >= b->lo.x && o.x <= b->hi.x && o.y >= b->lo.y && o.y <= b->hi.y && o.z >= b->lo.z &&
+              o.z <= b->hi.z))
+            continue;
+        float te = INFINITY;
+        int f = -1;
+        for (int a = 0; a < 3; a++) {
+            float d = murk_v3_get(r->d, a), oa = murk_v3_get(o, a);
+            float ta = d > 0.0f ? (murk_v3_get(b->hi, a) - oa) / d : (d < 0.0f ? (murk_v3_get(b->lo, a) - oa) / d : INFINITY);
+            if (ta < te) {
+                te = ta;
+                f = 2 * a + (d > 0.0f ? 0 : 1);
+            }
+        }
+        if (f < 0 || !(te > r->tmin))
+            return NULL;
+        *t = te;
+        *face = f;
+        return b;
+    }
+    return NULL;
+}
+
+/* Barycentrics (b1, b2) of p in triangle t of shape sh, clamped into the triangle; returns the smallest
+ * of the three before clamping (negative: p lies outside by that much). */
+static float barycentrics(const murk_shape *sh, uint32_t t, murk_vec3 p, float *b1, float *b2)
+{
+    const uint32_t *ix = &sh->idx[3 * (size_t)t];
+    murk_vec3 a = murk_shape_vertex(sh, ix[0]);
+    murk_vec3 e1 = murk_sub(murk_shape_vertex(sh, ix[1]), a), e2 = murk_sub(murk_shape_vertex(sh, ix[2]), a);
+    murk_vec3 q = murk_sub(p, a);
+    float d11 = murk_dot(e1, e1), d12 = murk_dot(e1, e2), d22 = murk_dot(e2, e2);
+    float q1 = murk_dot(q, e1), q2 = murk_dot(q, e2), det = d11 * d22 - d12 * d12;
+    float u = (d22 * q1 - d12 * q2) / det, v = (d11 * q2 - d12 * q1) / det;
+    float least = murk_minf(1.0f - u - v, murk_minf(u, v));
+    u = murk_minf(1.0f, murk_maxf(0.0f, u));
+    v = murk_minf(1.0f - u, murk_maxf(0.0f, v));
+    *b1 = u;
+    *b2 = v;
+    return least;
+}
+
+/* The hit where r leaves box b through face f at t, as Embree would report it: the face's triangle
+ * that holds the point, its barycentrics. */
+static void box_hit(const murk_scene *s, const murk_ray *r, const murk_empty_box *b, float t, int f, murk_hit *h)
+{
+    const murk_shape *sh = &s->shapes[b->geom];
+    murk_vec3 p = murk_madd(r->o, r->d, t);
+    float u0, v0, u1, v1;
+    int k = barycentrics(sh, b->face_tri[f][0], p, &u0, &v0) >= barycentrics(sh, b->face_tri[f][1], p, &u1, &v1) ? 0 : 1;
+    struct RTCRayHit rh;
+    rh.ray.tfar = t;
+    rh.hit.geomID = b->geom;
+    rh.hit.primID = b->face_tri[f][k];
+    rh.hit.u = k ? u1 : u0;
+    rh.hit.v = k ? v1 : v0;
+    fill_hit(s, r, &rh, h);
+}
+
 static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
 {
     if (!ray_traceable(r))
         return 0;
+    float te;
+    int face;
+    const murk_empty_box *b = s->nempty_boxes ? box_exit(s, r, &te, &face) : NULL;
+    if (b) {
+        if (!(te <= r->tmax))
+            return 0;
+        box_hit(s, r, b, te, face, h);
+        return 1;
+    }
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -176,6 +251,10 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
 {
     if (!ray_traceable(r))
         return 0;
+    float te;
+    int face;
+    if (s->nempty_boxes && box_exit(s, r, &te, &face)) /* nothing inside: only the box's own face occludes */
+        return te <= r->tmax;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay er;
