@@ -83,7 +83,17 @@ static int empty_box(const murk_scene *s, size_t i, murk_empty_box *b)
         int f = 2 * a + (g[a] > 0.0f ? 0 : 1);
         if (g[(a + 1) % 3] != 0.0f || g[(a + 2) % 3] != 0.0f || n[f] == 2) /* not axis-aligned */
             return 0;
-        b->face_tri[f][n[f]++] = t;
+        /* the dual basis of the edges e1, e2: p - a = b1 e1 + b2 e2 gives b1 = (p - a).g1, b2 = (p - a).g2 */
+        const uint32_t *tv = &sh->idx[3 * t];
+        murk_box_tri *bt = &b->tri[f][n[f]++];
+        bt->prim = t;
+        bt->a = murk_shape_vertex(sh, tv[0]);
+        murk_vec3 e1 = murk_sub(murk_shape_vertex(sh, tv[1]), bt->a), e2 = murk_sub(murk_shape_vertex(sh, tv[2]), bt->a);
+        float d11 = murk_dot(e1, e1), d12 = murk_dot(e1, e2), d22 = murk_dot(e2, e2), det = d11 * d22 - d12 * d12;
+        if (!(det > 0.0f))
+            return 0;
+        bt->g1 = murk_mul(murk_sub(murk_mul(e1, d22), murk_mul(e2, d12)), 1.0f / det);
+        bt->g2 = murk_mul(murk_sub(murk_mul(e2, d11), murk_mul(e1, d12)), 1.0f / det);
     }
     return 1;
 }

@@ -27,10 +27,14 @@ static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3
  * events of a medium in a box, the commonest medium setup, cost no traversal. At most
  * MURK_EMPTY_BOX_MAX per scene (each costs every ray an inside test). */
 enum { MURK_EMPTY_BOX_MAX = 8 };
+typedef struct murk_box_tri {
+    uint32_t prim;     /* the triangle's index in its shape */
+    murk_vec3 a, g1, g2; /* its first corner and dual edge vectors: barycentrics (b1, b2) = ((p-a).g1, (p-a).g2) */
+} murk_box_tri;
 typedef struct murk_empty_box {
     murk_vec3 lo, hi;
-    uint32_t geom;           /* the shape's index (its Embree geometry id) */
-    uint32_t face_tri[6][2]; /* the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
+    uint32_t geom;          /* the shape's index (its Embree geometry id) */
+    murk_box_tri tri[6][2]; /* the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
 } murk_empty_box;
 
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium boxes. */

@@ -182,39 +182,38 @@ static const murk_empty_box *box_exit(const murk_scene *s, const murk_ray *r, fl
     return NULL;
 }
 
-/* Barycentrics (b1, b2) of p in triangle t of shape sh, clamped into the triangle; returns the smallest
- * of the three before clamping (negative: p lies outside by that much). */
-static float barycentrics(const murk_shape *sh, uint32_t t, murk_vec3 p, float *b1, float *b2)
+/* Barycentrics (b1, b2) of p in box triangle bt, clamped into the triangle; returns the smallest of the
+ * three before clamping (negative: p lies outside by that much). */
+static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float *b2)
 {
-    const uint32_t *ix = &sh->idx[3 * (size_t)t];
-    murk_vec3 a = murk_shape_vertex(sh, ix[0]);
-    murk_vec3 e1 = murk_sub(murk_shape_vertex(sh, ix[1]), a), e2 = murk_sub(murk_shape_vertex(sh, ix[2]), a);
-    murk_vec3 q = murk_sub(p, a);
-    float d11 = murk_dot(e1, e1), d12 = murk_dot(e1, e2), d22 = murk_dot(e2, e2);
-    float q1 = murk_dot(q, e1), q2 = murk_dot(q, e2), det = d11 * d22 - d12 * d12;
-    float u = (d22 * q1 - d12 * q2) / det, v = (d11 * q2 - d12 * q1) / det;
+    murk_vec3 q = murk_sub(p, bt->a);
+    float u = murk_dot(q, bt->g1), v = murk_dot(q, bt->g2);
     float least = murk_minf(1.0f - u - v, murk_minf(u, v));
     u = murk_minf(1.0f, murk_maxf(0.0f, u));
-    v = murk_minf(1.0f - u, murk_maxf(0.0f, v));
     *b1 = u;
-    *b2 = v;
+    *b2 = murk_minf(1.0f - u, murk_maxf(0.0f, v));
     return least;
 }
 
 /* The hit where r leaves box b through face f at t, as Embree would report it: the face's triangle
- * that holds the point, its barycentrics. */
+ * that holds the point (the first unless the point lies outside it), its barycentrics. */
 static void box_hit(const murk_scene *s, const murk_ray *r, const murk_empty_box *b, float t, int f, murk_hit *h)
 {
-    const murk_shape *sh = &s->shapes[b->geom];
     murk_vec3 p = murk_madd(r->o, r->d, t);
-    float u0, v0, u1, v1;
-    int k = barycentrics(sh, b->face_tri[f][0], p, &u0, &v0) >= barycentrics(sh, b->face_tri[f][1], p, &u1, &v1) ? 0 : 1;
+    float u, v, u1, v1;
+    int k = 0;
+    float least = barycentrics(&b->tri[f][0], p, &u, &v);
+    if (least < 0.0f && barycentrics(&b->tri[f][1], p, &u1, &v1) > least) {
+        k = 1;
+        u = u1;
+        v = v1;
+    }
     struct RTCRayHit rh;
     rh.ray.tfar = t;
     rh.hit.geomID = b->geom;
-    rh.hit.primID = b->face_tri[f][k];
-    rh.hit.u = k ? u1 : u0;
-    rh.hit.v = k ? v1 : v0;
+    rh.hit.primID = b->tri[f][k].prim;
+    rh.hit.u = u;
+    rh.hit.v = v;
     fill_hit(s, r, &rh, h);
 }
 
