@@ -20,6 +20,16 @@ enum { DDA_BEFORE, DDA_ENTER, DDA_INSIDE, DDA_AFTER, DDA_DONE };
 
 void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, float t0, float t1)
 {
+    if (isinf(g->lo.x) && t0 < t1) { /* infinite (constant) grid: one segment; murk_dda_next reads only
+                                      * these fields of it (a homogeneous medium's every flight and shadow
+                                      * ray starts here, so the clearing below is skipped) */
+        it->g = g;
+        it->t = it->tin = t0;
+        it->t1 = it->tout = t1;
+        it->cell[0] = it->cell[1] = it->cell[2] = -1;
+        it->phase = DDA_INSIDE;
+        return;
+    }
     memset(it, 0, sizeof *it);
     it->g = g;
     it->t = t0;
@@ -36,12 +46,6 @@ void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, fl
         return;
     }
     it->phase = DDA_AFTER;
-    if (isinf(g->lo.x)) { /* infinite (constant) grid: one segment */
-        it->tin = t0;
-        it->tout = t1;
-        it->phase = DDA_INSIDE;
-        return;
-    }
     double tin = t0, tout = t1;
     for (int a = 0; a < 3; a++) {
         double o = it->o[a], d = it->d[a], lo = murk_v3_get(g->lo, a), hi = murk_v3_get(g->hi, a);
