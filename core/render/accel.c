@@ -163,7 +163,11 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
     s->empty_boxes = NULL;
     s->nempty_boxes = 0;
     murk_empty_box b;
-    for (size_t i = 0; i < s->nshapes && s->nempty_boxes < MURK_EMPTY_BOX_MAX; i++) {
+    /* each candidate is checked against every primitive of the scene: at most 2 x MURK_EMPTY_BOX_MAX of
+     * them, so that a scene of many medium boxes and a large mesh does not pay boxes x triangles at load */
+    int tried = 0;
+    for (size_t i = 0; i < s->nshapes && s->nempty_boxes < MURK_EMPTY_BOX_MAX && tried < 2 * MURK_EMPTY_BOX_MAX; i++) {
+        tried += s->shapes[i].type == MURK_SHAPE_BOX && s->shapes[i].interior;
         if (!empty_box(s, i, &b))
             continue;
         if (!s->empty_boxes)

@@ -25,7 +25,8 @@ static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3
  * box. A ray that starts inside it meets one of its faces before anything else, so host.c finds that
  * face by a slab test instead of asking Embree — the free flights and shadow rays from the scattering
  * events of a medium in a box, the commonest medium setup, cost no traversal. At most
- * MURK_EMPTY_BOX_MAX per scene (each costs every ray an inside test). */
+ * MURK_EMPTY_BOX_MAX per scene (each costs every ray an inside test), found among the first
+ * 2 x MURK_EMPTY_BOX_MAX medium boxes (each is checked against every primitive at load). */
 enum { MURK_EMPTY_BOX_MAX = 8 };
 typedef struct murk_box_tri {
     uint32_t prim;     /* the triangle's index in its shape */
