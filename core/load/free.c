@@ -24,7 +24,7 @@ MURK_API void murk_scene_free(murk_scene *s)
     if (!s)
         return;
     murk_warn_forget(s);
-    free(s->empty_boxes);
+    free(s->empty_shapes);
     if (s->rtc)
         rtcReleaseScene(s->rtc);
     if (s->device)

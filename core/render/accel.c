@@ -47,17 +47,21 @@ static int boxes_meet(murk_vec3 alo, murk_vec3 ahi, murk_vec3 blo, murk_vec3 bhi
     return alo.x <= bhi.x && blo.x <= ahi.x && alo.y <= bhi.y && blo.y <= ahi.y && alo.z <= bhi.z && blo.z <= ahi.z;
 }
 
-/* Box shape i as an empty medium box (accel.h), or 0: it holds no medium, something else meets it, or
- * its faces are not two triangles each with axis-aligned normals. "Meets" uses the box grown by 1e-4 of
- * its coordinates' magnitude (the integrators' offset off a surface): a shape on or within rounding of a
- * face could tie with the face or beat it in Embree's arithmetic, so such a box is left to Embree. */
-static int empty_box(const murk_scene *s, size_t i, murk_empty_box *b)
+/* Shape i as an empty medium shape (accel.h), or 0: not a box or a sphere, it holds no medium, something
+ * else meets it, or (a box) its faces are not two triangles each with axis-aligned normals. "Meets" uses
+ * its bounds grown by 1e-4 of their coordinates' magnitude (the integrators' offset off a surface): a
+ * shape on or within rounding of its surface could tie with it or beat it in Embree's arithmetic, so such
+ * a shape is left to Embree. */
+static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
 {
     const murk_shape *sh = &s->shapes[i];
-    if (sh->type != MURK_SHAPE_BOX || !sh->interior || sh->ntris != 12)
+    b->sphere = sh->type == MURK_SHAPE_SPHERE;
+    if (!sh->interior || !(b->sphere || (sh->type == MURK_SHAPE_BOX && sh->ntris == 12)))
         return 0;
-    b->lo = b->hi = murk_shape_vertex(sh, 0);
-    for (uint32_t v = 1; v < sh->nverts; v++) {
+    b->center = sh->center;
+    b->radius = sh->radius;
+    prim_bounds(sh, 0, &b->lo, &b->hi);
+    for (uint32_t v = 0; !b->sphere && v < sh->nverts; v++) {
         murk_vec3 p = murk_shape_vertex(sh, v);
         b->lo = murk_v3(murk_minf(b->lo.x, p.x), murk_minf(b->lo.y, p.y), murk_minf(b->lo.z, p.z));
         b->hi = murk_v3(murk_maxf(b->hi.x, p.x), murk_maxf(b->hi.y, p.y), murk_maxf(b->hi.z, p.z));
@@ -77,7 +81,7 @@ static int empty_box(const murk_scene *s, size_t i, murk_empty_box *b)
     }
     int n[6] = {0};
     b->geom = (uint32_t)i;
-    for (uint32_t t = 0; t < 12; t++) {
+    for (uint32_t t = 0; !b->sphere && t < 12; t++) {
         const float *g = &sh->ng[3 * t];
         int a = fabsf(g[0]) > 0.5f ? 0 : (fabsf(g[1]) > 0.5f ? 1 : 2);
         int f = 2 * a + (g[a] > 0.0f ? 0 : 1);
@@ -159,20 +163,21 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
         murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
         return -1;
     }
-    free(s->empty_boxes);
-    s->empty_boxes = NULL;
-    s->nempty_boxes = 0;
-    murk_empty_box b;
-    /* each candidate is checked against every primitive of the scene: at most 2 x MURK_EMPTY_BOX_MAX of
-     * them, so that a scene of many medium boxes and a large mesh does not pay boxes x triangles at load */
+    free(s->empty_shapes);
+    s->empty_shapes = NULL;
+    s->nempty_shapes = 0;
+    murk_empty_shape b;
+    /* each candidate is checked against every primitive of the scene: at most 2 x MURK_EMPTY_SHAPE_MAX of
+     * them, so that a scene of many medium shapes and a large mesh does not pay shapes x triangles at load */
     int tried = 0;
-    for (size_t i = 0; i < s->nshapes && s->nempty_boxes < MURK_EMPTY_BOX_MAX && tried < 2 * MURK_EMPTY_BOX_MAX; i++) {
-        tried += s->shapes[i].type == MURK_SHAPE_BOX && s->shapes[i].interior;
-        if (!empty_box(s, i, &b))
+    for (size_t i = 0; i < s->nshapes && s->nempty_shapes < MURK_EMPTY_SHAPE_MAX && tried < 2 * MURK_EMPTY_SHAPE_MAX; i++) {
+        const murk_shape *sh = &s->shapes[i];
+        tried += (sh->type == MURK_SHAPE_BOX || sh->type == MURK_SHAPE_SPHERE) && sh->interior;
+        if (!empty_shape(s, i, &b))
             continue;
-        if (!s->empty_boxes)
-            s->empty_boxes = murk_xmalloc(MURK_EMPTY_BOX_MAX * sizeof *s->empty_boxes);
-        s->empty_boxes[s->nempty_boxes++] = b;
+        if (!s->empty_shapes)
+            s->empty_shapes = murk_xmalloc(MURK_EMPTY_SHAPE_MAX * sizeof *s->empty_shapes);
+        s->empty_shapes[s->nempty_shapes++] = b;
     }
     return 0;
 }

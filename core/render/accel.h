@@ -21,24 +21,28 @@ static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3
     return murk_normalize(murk_cross(murk_sub(b, a), murk_sub(c, a)));
 }
 
-/* A box shape holding a medium (interior set) and nothing else: no other shape's bounds meet the closed
- * box. A ray that starts inside it meets one of its faces before anything else, so host.c finds that
- * face by a slab test instead of asking Embree — the free flights and shadow rays from the scattering
- * events of a medium in a box, the commonest medium setup, cost no traversal. At most
- * MURK_EMPTY_BOX_MAX per scene (each costs every ray an inside test), found among the first
- * 2 x MURK_EMPTY_BOX_MAX medium boxes (each is checked against every primitive at load). */
-enum { MURK_EMPTY_BOX_MAX = 8 };
+/* A box or sphere shape holding a medium (interior set) and nothing else: no other shape's bounds meet
+ * its bounds. A ray that starts inside it meets its surface before anything else, so host.c finds that
+ * point by a slab test (a box) or the far root of a quadratic (a sphere) instead of asking Embree: the
+ * free flights and shadow rays from the scattering events of a medium in a box or a sphere, the
+ * commonest medium setups, cost no traversal. At most MURK_EMPTY_SHAPE_MAX per scene (each costs every
+ * ray an inside test), found among the first 2 x MURK_EMPTY_SHAPE_MAX medium boxes and spheres (each is
+ * checked against every primitive at load). */
+enum { MURK_EMPTY_SHAPE_MAX = 8 };
 typedef struct murk_box_tri {
     uint32_t prim;     /* the triangle's index in its shape */
     murk_vec3 a, g1, g2; /* its first corner and dual edge vectors: barycentrics (b1, b2) = ((p-a).g1, (p-a).g2) */
 } murk_box_tri;
-typedef struct murk_empty_box {
-    murk_vec3 lo, hi;
+typedef struct murk_empty_shape {
+    murk_vec3 lo, hi;       /* its bounds */
     uint32_t geom;          /* the shape's index (its Embree geometry id) */
-    murk_box_tri tri[6][2]; /* the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
-} murk_empty_box;
+    int sphere;             /* 1: a sphere (center, radius), else a box (tri) */
+    murk_vec3 center;
+    float radius;
+    murk_box_tri tri[6][2]; /* a box: the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
+} murk_empty_shape;
 
-/* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium boxes. */
+/* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium shapes. */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 
 #endif

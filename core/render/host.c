@@ -152,20 +152,38 @@ static int ray_traceable(const murk_ray *r)
     return ok;
 }
 
-/* A ray from inside an empty medium box (accel.h): the box, the distance *t to where the ray leaves it
- * and the face it leaves by (2a for the +a side, 2a + 1 for -a); NULL when no such box holds the origin,
- * or when the exit lies at or before tmin (a ray leaving from a face): Embree decides then. */
-static const murk_empty_box *box_exit(const murk_scene *s, const murk_ray *r, float *t, int *face)
+/* Where a ray from a point o inside sphere (center, radius) leaves it: the far root of |o + t d - c|^2 =
+ * r^2, in the form that does not cancel (Numerical Recipes §5.6); +inf when o is not strictly inside. */
+static float sphere_exit(murk_vec3 center, float radius, const murk_ray *r)
 {
-    for (size_t i = 0; i < s->nempty_boxes; i++) {
-        const murk_empty_box *b = &s->empty_boxes[i];
+    murk_vec3 oc = murk_sub(r->o, center);
+    float c = murk_dot(oc, oc) - radius * radius, a = murk_dot(r->d, r->d), b = murk_dot(r->d, oc);
+    if (!(c < 0.0f) || !(a > 0.0f))
+        return INFINITY;
+    float q = sqrtf(b * b - a * c);
+    return b > 0.0f ? -c / (b + q) : (q - b) / a;
+}
+
+/* A ray from inside an empty medium shape (accel.h): the shape, the distance *t to where the ray leaves
+ * it and, for a box, the face it leaves by (2a for the +a side, 2a + 1 for -a; -1 for a sphere); NULL
+ * when no such shape holds the origin, or when the exit lies at or before tmin (a ray leaving from its
+ * surface): Embree decides then. */
+static const murk_empty_shape *shape_exit(const murk_scene *s, const murk_ray *r, float *t, int *face)
+{
+    for (size_t i = 0; i < s->nempty_shapes; i++) {
+        const murk_empty_shape *b = &s->empty_shapes[i];
         const murk_vec3 o = r->o;
         if (!(o.x >= b->lo.x && o.x <= b->hi.x && o.y >= b->lo.y && o.y <= b->hi.y && o.z >= b->lo.z &&
               o.z <= b->hi.z))
             continue;
         float te = INFINITY;
         int f = -1;
-        for (int a = 0; a < 3; a++) {
+        if (b->sphere) {
+            te = sphere_exit(b->center, b->radius, r);
+            if (isinf(te))
+                continue; /* in its bounds, not inside it */
+        }
+        for (int a = 0; a < 3 && !b->sphere; a++) {
             float d = murk_v3_get(r->d, a), oa = murk_v3_get(o, a);
             float ta = d > 0.0f ? (murk_v3_get(b->hi, a) - oa) / d : (d < 0.0f ? (murk_v3_get(b->lo, a) - oa) / d : INFINITY);
             if (ta < te) {
@@ -173,7 +191,7 @@ static const murk_empty_box *box_exit(const murk_scene *s, const murk_ray *r, fl
                 f = 2 * a + (d > 0.0f ? 0 : 1);
             }
         }
-        if (f < 0 || !(te > r->tmin))
+        if ((!b->sphere && f < 0) || !(te > r->tmin))
             return NULL;
         *t = te;
         *face = f;
@@ -195,23 +213,26 @@ static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float 
     return least;
 }
 
-/* The hit where r leaves box b through face f at t, as Embree would report it: the face's triangle
- * that holds the point (the first unless the point lies outside it), its barycentrics. */
-static void box_hit(const murk_scene *s, const murk_ray *r, const murk_empty_box *b, float t, int f, murk_hit *h)
+/* The hit where r leaves shape b at t (a box: through face f), as Embree would report it: a sphere's
+ * only primitive; a box face's triangle that holds the point (the first unless the point lies outside
+ * it) and its barycentrics. */
+static void exit_hit(const murk_scene *s, const murk_ray *r, const murk_empty_shape *b, float t, int f, murk_hit *h)
 {
-    murk_vec3 p = murk_madd(r->o, r->d, t);
-    float u, v, u1, v1;
+    float u = 0.0f, v = 0.0f, u1, v1;
     int k = 0;
-    float least = barycentrics(&b->tri[f][0], p, &u, &v);
-    if (least < 0.0f && barycentrics(&b->tri[f][1], p, &u1, &v1) > least) {
-        k = 1;
-        u = u1;
-        v = v1;
+    if (!b->sphere) {
+        murk_vec3 p = murk_madd(r->o, r->d, t);
+        float least = barycentrics(&b->tri[f][0], p, &u, &v);
+        if (least < 0.0f && barycentrics(&b->tri[f][1], p, &u1, &v1) > least) {
+            k = 1;
+            u = u1;
+            v = v1;
+        }
     }
     struct RTCRayHit rh;
     rh.ray.tfar = t;
     rh.hit.geomID = b->geom;
-    rh.hit.primID = b->tri[f][k].prim;
+    rh.hit.primID = b->sphere ? 0 : b->tri[f][k].prim;
     rh.hit.u = u;
     rh.hit.v = v;
     fill_hit(s, r, &rh, h);
@@ -223,11 +244,11 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
         return 0;
     float te;
     int face;
-    const murk_empty_box *b = s->nempty_boxes ? box_exit(s, r, &te, &face) : NULL;
+    const murk_empty_shape *b = s->nempty_shapes ? shape_exit(s, r, &te, &face) : NULL;
     if (b) {
         if (!(te <= r->tmax))
             return 0;
-        box_hit(s, r, b, te, face, h);
+        exit_hit(s, r, b, te, face, h);
         return 1;
     }
     struct RTCIntersectContext ctx;
@@ -252,7 +273,7 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
         return 0;
     float te;
     int face;
-    if (s->nempty_boxes && box_exit(s, r, &te, &face)) /* nothing inside: only the box's own face occludes */
+    if (s->nempty_shapes && shape_exit(s, r, &te, &face)) /* nothing inside: only its own surface occludes */
         return te <= r->tmax;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

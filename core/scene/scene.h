@@ -126,8 +126,8 @@ struct murk_scene {
     murk_shape *shapes; /* index = Embree geometry id */
     size_t nshapes;
     size_t nboundaries; /* shapes without a material: index-matched boundaries (set by murk_accel_build) */
-    struct murk_empty_box *empty_boxes; /* medium boxes with nothing inside (murk_accel_build; render/accel.h) */
-    size_t nempty_boxes;
+    struct murk_empty_shape *empty_shapes; /* medium boxes and spheres with nothing else inside (render/accel.h) */
+    size_t nempty_shapes;
     murk_light *lights;
     size_t nlights;
     float *light_cdf; /* nlights + 1 */

@@ -17,8 +17,8 @@
  *                    no collision: they count none, only lookups;
  *   scatters, shadow the core, around every medium's sample() (flights that ended in a real scattering
  *                    event) and transmittance estimate (shadow-ray segments).
- * Rays traced (the intersect and occluded calls that reach Embree; a ray from inside an empty medium box is
- * answered by a slab test and not counted) are counted per render, not per medium (murk_render_result.rays). */
+ * Rays traced (the intersect and occluded calls that reach Embree; a ray from inside an empty medium box or
+ * sphere is answered in closed form and not counted) are counted per render, not per medium (murk_render_result.rays). */
 #ifndef MURK_COUNTERS_H
 #define MURK_COUNTERS_H
 
