@@ -538,25 +538,15 @@ static int finish_camera(murk_scene *s, const murk_ynode *camera, camera_request
     return camera_frame(s, req->at, err, errlen);
 }
 
-static murk_vec3 vmin3(murk_vec3 a, murk_vec3 b) { return murk_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
-static murk_vec3 vmax3(murk_vec3 a, murk_vec3 b) { return murk_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
-
 /* The box around the camera and every shape: how far a constant-density medium can reach. */
 static void scene_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi)
 {
     *lo = *hi = s->cam_from;
     for (size_t i = 0; i < s->nshapes; i++) {
-        const murk_shape *sh = &s->shapes[i];
-        if (sh->type == MURK_SHAPE_SPHERE) {
-            murk_vec3 r = murk_v3(sh->radius, sh->radius, sh->radius);
-            *lo = vmin3(*lo, murk_sub(sh->center, r));
-            *hi = vmax3(*hi, murk_add(sh->center, r));
-        }
-        for (uint32_t v = 0; sh->pos && v < sh->nverts; v++) {
-            murk_vec3 p = murk_v3(sh->pos[3 * v], sh->pos[3 * v + 1], sh->pos[3 * v + 2]);
-            *lo = vmin3(*lo, p);
-            *hi = vmax3(*hi, p);
-        }
+        murk_vec3 a, b;
+        murk_shape_bounds(&s->shapes[i], &a, &b);
+        *lo = murk_vmin(*lo, a);
+        *hi = murk_vmax(*hi, b);
     }
 }
 

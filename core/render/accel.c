@@ -28,19 +28,18 @@ static bool embree_memory(void *user, ssize_t bytes, bool post)
 static void prim_bounds(const murk_shape *sh, uint32_t t, murk_vec3 *lo, murk_vec3 *hi)
 {
     if (sh->type == MURK_SHAPE_SPHERE) {
-        murk_vec3 r = murk_v3(sh->radius, sh->radius, sh->radius);
-        *lo = murk_sub(sh->center, r);
-        *hi = murk_add(sh->center, r);
+        murk_shape_bounds(sh, lo, hi);
         return;
     }
     const uint32_t *tv = &sh->idx[3 * t];
     *lo = *hi = murk_shape_vertex(sh, tv[0]);
     for (int k = 1; k < 3; k++) {
-        murk_vec3 v = murk_shape_vertex(sh, tv[k]);
-        *lo = murk_v3(murk_minf(lo->x, v.x), murk_minf(lo->y, v.y), murk_minf(lo->z, v.z));
-        *hi = murk_v3(murk_maxf(hi->x, v.x), murk_maxf(hi->y, v.y), murk_maxf(hi->z, v.z));
+        *lo = murk_vmin(*lo, murk_shape_vertex(sh, tv[k]));
+        *hi = murk_vmax(*hi, murk_shape_vertex(sh, tv[k]));
     }
 }
+
+static float maxabs(murk_vec3 v) { return murk_maxf(fabsf(v.x), murk_maxf(fabsf(v.y), fabsf(v.z))); }
 
 static int boxes_meet(murk_vec3 alo, murk_vec3 ahi, murk_vec3 blo, murk_vec3 bhi)
 {
@@ -60,15 +59,8 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
         return 0;
     b->center = sh->center;
     b->radius = sh->radius;
-    prim_bounds(sh, 0, &b->lo, &b->hi);
-    for (uint32_t v = 0; !b->sphere && v < sh->nverts; v++) {
-        murk_vec3 p = murk_shape_vertex(sh, v);
-        b->lo = murk_v3(murk_minf(b->lo.x, p.x), murk_minf(b->lo.y, p.y), murk_minf(b->lo.z, p.z));
-        b->hi = murk_v3(murk_maxf(b->hi.x, p.x), murk_maxf(b->hi.y, p.y), murk_maxf(b->hi.z, p.z));
-    }
-    float m = 1e-4f * murk_maxf(1.0f, murk_maxf(murk_maxf(fabsf(b->lo.x), fabsf(b->lo.y)),
-                                                 murk_maxf(murk_maxf(fabsf(b->lo.z), fabsf(b->hi.x)),
-                                                           murk_maxf(fabsf(b->hi.y), fabsf(b->hi.z)))));
+    murk_shape_bounds(sh, &b->lo, &b->hi);
+    float m = 1e-4f * murk_maxf(1.0f, murk_maxf(maxabs(b->lo), maxabs(b->hi)));
     murk_vec3 glo = murk_sub(b->lo, murk_v3(m, m, m)), ghi = murk_add(b->hi, murk_v3(m, m, m));
     for (size_t j = 0; j < s->nshapes; j++) {
         const murk_shape *o = &s->shapes[j];

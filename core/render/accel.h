@@ -3,6 +3,7 @@
 #ifndef MURK_ACCEL_H
 #define MURK_ACCEL_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include "scene/scene.h"
@@ -12,6 +13,23 @@ static inline murk_vec3 murk_shape_vertex(const murk_shape *sh, size_t i)
 {
     const float *v = &sh->pos[3 * i]; /* size_t: one address, the three floats at constant offsets */
     return murk_v3(v[0], v[1], v[2]);
+}
+
+/* The bounds of shape sh: a sphere's box, or its vertices'. */
+static inline void murk_shape_bounds(const murk_shape *sh, murk_vec3 *lo, murk_vec3 *hi)
+{
+    if (sh->type == MURK_SHAPE_SPHERE) {
+        murk_vec3 r = murk_v3(sh->radius, sh->radius, sh->radius);
+        *lo = murk_sub(sh->center, r);
+        *hi = murk_add(sh->center, r);
+        return;
+    }
+    *lo = murk_v3(INFINITY, INFINITY, INFINITY);
+    *hi = murk_v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t v = 0; sh->pos && v < sh->nverts; v++) {
+        *lo = murk_vmin(*lo, murk_shape_vertex(sh, v));
+        *hi = murk_vmax(*hi, murk_shape_vertex(sh, v));
+    }
 }
 
 /* The unit geometric normal of triangle (a, b, c): (b - a) x (c - a), normalised. accel.c stores it per

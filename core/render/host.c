@@ -164,10 +164,26 @@ static float sphere_exit(murk_vec3 center, float radius, const murk_ray *r)
     return b > 0.0f ? -c / (b + q) : (q - b) / a;
 }
 
+/* Where a ray from a point inside box b leaves it: the nearest of the three planes ahead of it, and in
+ * *face which (2a for the +a side, 2a + 1 for -a; -1 if the direction is 0). */
+static float box_exit(const murk_empty_shape *b, const murk_ray *r, int *face)
+{
+    float te = INFINITY;
+    *face = -1;
+    for (int a = 0; a < 3; a++) {
+        float d = murk_v3_get(r->d, a), oa = murk_v3_get(r->o, a);
+        float ta = d > 0.0f ? (murk_v3_get(b->hi, a) - oa) / d : (d < 0.0f ? (murk_v3_get(b->lo, a) - oa) / d : INFINITY);
+        if (ta < te) {
+            te = ta;
+            *face = 2 * a + (d > 0.0f ? 0 : 1);
+        }
+    }
+    return te;
+}
+
 /* A ray from inside an empty medium shape (accel.h): the shape, the distance *t to where the ray leaves
- * it and, for a box, the face it leaves by (2a for the +a side, 2a + 1 for -a; -1 for a sphere); NULL
- * when no such shape holds the origin, or when the exit lies at or before tmin (a ray leaving from its
- * surface): Embree decides then. */
+ * it and, for a box, the face it leaves by (-1 for a sphere); NULL when no such shape holds the origin,
+ * or when the exit lies at or before tmin (a ray leaving from its surface): Embree decides then. */
 static const murk_empty_shape *shape_exit(const murk_scene *s, const murk_ray *r, float *t, int *face)
 {
     for (size_t i = 0; i < s->nempty_shapes; i++) {
@@ -176,25 +192,13 @@ static const murk_empty_shape *shape_exit(const murk_scene *s, const murk_ray *r
         if (!(o.x >= b->lo.x && o.x <= b->hi.x && o.y >= b->lo.y && o.y <= b->hi.y && o.z >= b->lo.z &&
               o.z <= b->hi.z))
             continue;
-        float te = INFINITY;
-        int f = -1;
-        if (b->sphere) {
-            te = sphere_exit(b->center, b->radius, r);
-            if (isinf(te))
-                continue; /* in its bounds, not inside it */
-        }
-        for (int a = 0; a < 3 && !b->sphere; a++) {
-            float d = murk_v3_get(r->d, a), oa = murk_v3_get(o, a);
-            float ta = d > 0.0f ? (murk_v3_get(b->hi, a) - oa) / d : (d < 0.0f ? (murk_v3_get(b->lo, a) - oa) / d : INFINITY);
-            if (ta < te) {
-                te = ta;
-                f = 2 * a + (d > 0.0f ? 0 : 1);
-            }
-        }
-        if ((!b->sphere && f < 0) || !(te > r->tmin))
+        *face = -1;
+        float te = b->sphere ? sphere_exit(b->center, b->radius, r) : box_exit(b, r, face);
+        if (b->sphere && isinf(te))
+            continue; /* in the sphere's bounds, not inside it */
+        if (!(te > r->tmin) || isinf(te))
             return NULL;
         *t = te;
-        *face = f;
         return b;
     }
     return NULL;

@@ -49,6 +49,9 @@ static inline murk_vec3 murk_normalize(murk_vec3 a)
     return l > 0.0f ? murk_mul(a, 1.0f / l) : a;
 }
 static inline float murk_v3_get(murk_vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
+/* Componentwise minimum and maximum (fminf/fmaxf: a NaN component gives the other's). */
+static inline murk_vec3 murk_vmin(murk_vec3 a, murk_vec3 b) { return murk_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
+static inline murk_vec3 murk_vmax(murk_vec3 a, murk_vec3 b) { return murk_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
 
 /* Orthonormal basis around unit n (Duff et al. 2017, branchless). */
 static inline void murk_basis(murk_vec3 n, murk_vec3 *t, murk_vec3 *b)
