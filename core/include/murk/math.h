@@ -220,6 +220,66 @@ static inline void murk_sample_2d(murk_rng *r, float u[2])
     u[0] = murk_u24_((uint32_t)ab);
     u[1] = murk_u24_((uint32_t)(ab >> 32));
 }
+/* Sobol dimensions 2 and 3 (Joe and Kuo 2008's third and fourth: x^2 + x + 1 with m = 1, 3 and
+ * x^3 + x + 1 with m = 1, 3, 1), four index bits at a time: entry [n][v] is the XOR of both generator
+ * matrices' columns 4n..4n+3 that the nibble v selects, dimension 3 in the high word. */
+static const uint64_t murk_sobol23_[8][16] = {
+    {0x0000000000000000ull, 0x8000000080000000ull, 0xc0000000c0000000ull, 0x4000000040000000ull,
+     0x2000000060000000ull, 0xa0000000e0000000ull, 0xe0000000a0000000ull, 0x6000000020000000ull,
+     0x5000000090000000ull, 0xd000000010000000ull, 0x9000000050000000ull, 0x10000000d0000000ull,
+     0x70000000f0000000ull, 0xf000000070000000ull, 0xb000000030000000ull, 0x30000000b0000000ull},
+    {0x0000000000000000ull, 0xf8000000e8000000ull, 0x740000005c000000ull, 0x8c000000b4000000ull,
+     0xa20000008e000000ull, 0x5a00000066000000ull, 0xd6000000d2000000ull, 0x2e0000003a000000ull,
+     0x93000000c5000000ull, 0x6b0000002d000000ull, 0xe700000099000000ull, 0x1f00000071000000ull,
+     0x310000004b000000ull, 0xc9000000a3000000ull, 0x4500000017000000ull, 0xbd000000ff000000ull},
+    {0x0000000000000000ull, 0xd880000068800000ull, 0x254000009cc00000ull, 0xfdc00000f4400000ull,
+     0x59e00000ee600000ull, 0x8160000086e00000ull, 0x7ca0000072a00000ull, 0xa42000001a200000ull,
+     0xe6d0000055900000ull, 0x3e5000003d100000ull, 0xc3900000c9500000ull, 0x1b100000a1d00000ull,
+     0xbf300000bbf00000ull, 0x67b00000d3700000ull, 0x9a70000027300000ull, 0x42f000004fb00000ull},
+    {0x0000000000000000ull, 0x7808000080680000ull, 0xb40c0000c09c0000ull, 0xcc04000040f40000ull,
+     0x8202000060ee0000ull, 0xfa0a0000e0860000ull, 0x360e0000a0720000ull, 0x4e060000201a0000ull,
+     0xc305000090550000ull, 0xbb0d0000103d0000ull, 0x7709000050c90000ull, 0x0f010000d0a10000ull,
+     0x41070000f0bb0000ull, 0x390f000070d30000ull, 0xf50b000030270000ull, 0x8d030000b04f0000ull},
+    {0x0000000000000000ull, 0x208f8000e8808000ull, 0x514740005cc0c000ull, 0x71c8c000b4404000ull,
+     0xfbea20008e606000ull, 0xdb65a00066e0e000ull, 0xaaad6000d2a0a000ull, 0x8a22e0003a202000ull,
+     0x75d93000c5909000ull, 0x5556b0002d101000ull, 0x249e700099505000ull, 0x0411f00071d0d000ull,
+     0x8e3310004bf0f000ull, 0xaebc9000a3707000ull, 0xdf74500017303000ull, 0xfffbd000ffb0b000ull},
+    {0x0000000000000000ull, 0xa08588006868e800ull, 0x914e54009c9c5c00ull, 0x31cbdc00f4f4b400ull,
+     0xdbe79e00eeee8e00ull, 0x7b62160086866600ull, 0x4aa9ca007272d200ull, 0xea2c42001a1a3a00ull,
+     0x25db6d005555c500ull, 0x855ee5003d3d2d00ull, 0xb4953900c9c99900ull, 0x1410b100a1a17100ull,
+     0xfe3cf300bbbb4b00ull, 0x5eb97b00d3d3a300ull, 0x6f72a70027271700ull, 0xcff72f004f4fff00ull},
+    {0x0000000000000000ull, 0x588000808000e880ull, 0xe54000c0c0005cc0ull, 0xbdc000404000b440ull,
+     0x79e0002060008e60ull, 0x216000a0e00066e0ull, 0x9ca000e0a000d2a0ull, 0xc420006020003a20ull,
+     0xb6d000509000c590ull, 0xee5000d010002d10ull, 0x5390009050009950ull, 0x0b100010d00071d0ull,
+     0xcf300070f0004bf0ull, 0x97b000f07000a370ull, 0x2a7000b030001730ull, 0x72f00030b000ffb0ull},
+    {0x0000000000000000ull, 0x800800f8e8006868ull, 0xc00c00745c009c9cull, 0x4004008cb400f4f4ull,
+     0x200200a28e00eeeeull, 0xa00a005a66008686ull, 0xe00e00d6d2007272ull, 0x6006002e3a001a1aull,
+     0x50050093c5005555ull, 0xd00d006b2d003d3dull, 0x900900e79900c9c9ull, 0x1001001f7100a1a1ull,
+     0x700700314b00bbbbull, 0xf00f00c9a300d3d3ull, 0xb00b004517002727ull, 0x300300bdff004f4full},
+};
+
+/* The next 2-D draw as the partner of slot `with`: Sobol dimensions 2 and 3 of that slot's shuffled
+ * index (whose dimensions 0 and 1 are its own point), each with a nested uniform scramble of its own.
+ * The two points together are then one 4-D Owen-scrambled Sobol point (Burley 2020 pads with blocks of
+ * any dimension): the first 2^k samples of a pixel stratify the pair jointly, e.g. a vertex's light
+ * point with the direction or distance that placed the vertex, which two independent slots do not.
+ * The partner's own 2-D projection is a (t, k, 2)-net with t <= 2 rather than 0. With
+ * MURK_SAMPLER_INDEPENDENT it is murk_sample_2d. Takes the next slot's place (the slot counter advances). */
+static inline void murk_sample_2d_with(murk_rng *r, uint32_t with, float u[2])
+{
+    if (r->sampler != MURK_SAMPLER_SOBOL) {
+        murk_sample_2d(r, u);
+        return;
+    }
+    r->dim++;
+    uint64_t h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(with + 1u)), x = 0u;
+    uint32_t i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)h)); /* as murk_sample_slot_ */
+    for (int n = 0; n < 8; n++)
+        x ^= murk_sobol23_[n][(i >> (4 * n)) & 15u];
+    uint64_t g = murk_hash64(h ^ 0xd1b54a32d192ed03ull);
+    u[0] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_reverse_bits32((uint32_t)x), (uint32_t)g)));
+    u[1] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_reverse_bits32((uint32_t)(x >> 32)), (uint32_t)(g >> 32))));
+}
 /* The next slot as one number in [0, 1). */
 static inline float murk_sample_1d(murk_rng *r)
 {
