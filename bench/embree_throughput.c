@@ -360,8 +360,8 @@ static BARE_INLINE murk_rgb bare_li(const bare_pt *bt, murk_ray cam, murk_rng *r
         murk_vec3 po = bare_offset(p, n);
         float u[3];
         murk_sample_seek(rng, 2u + (uint32_t)depth * 5u); /* the slots `path` uses (pathtracer.c) */
-        u[0] = murk_sample_1d(rng);
-        murk_sample_2d(rng, u + 1);
+        u[0] = murk_sample_1d(rng); /* the light point: the partner of the camera jitter or last direction */
+        murk_sample_2d_with(rng, depth ? 2u + (uint32_t)(depth - 1) * 5u + 2u : 0u, u + 1);
         murk_vec3 wi, q;
         float lpdf, dist, cosi = 0.0f;
         murk_rgb le = murk_rgb1(0.0f);

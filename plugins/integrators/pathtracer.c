@@ -128,9 +128,12 @@ void murk_pt_destroy(void *self)
 
 /* The sampler's slots (murk/math.h), in this order in every sample: 0 the camera jitter (the core),
  * 1 the hero channel, then per scattering event d = 0, 1, ... (a surface or a medium vertex) five
- * slots from PT_SLOT(d, 0): the light choice (1-D) and the point on the light (2-D) of NEE, the
+ * slots from PT_SLOT(d, 0): the light choice (1-D) and the point on the light of NEE, the
  * BSDF / phase direction (2-D), the BSDF's lobe choice (1-D, u[2] of a material's sample()) and the
- * Russian roulette after the event (1-D). Trackers and transmittance estimators take their numbers
+ * Russian roulette after the event (1-D). The point on the light takes its slot's place but is drawn as
+ * the partner (murk_sample_2d_with: Sobol dimensions 2 and 3) of the draw that placed the vertex: the
+ * camera jitter or the last event's direction for a surface, the free flight's slot for a medium vertex,
+ * the distance for an equiangular one. Trackers and transmittance estimators take their numbers
  * from the PCG stream (murk_rng_float), outside the slots. */
 enum { PT_SLOT_HERO = 1 };
 /* With equiangular sampling, each medium segment's own slots, apart from the events' (slots are hashed:
@@ -291,6 +294,10 @@ typedef struct path {
                       * radiance picks up entering a denser medium (for Russian roulette only) */
 } path;
 
+/* The slot whose draw placed the path's next surface vertex: the camera's jitter (slot 0) for the first,
+ * else the direction sampled at the last scattering event (sample_light's partner for that vertex). */
+static uint32_t placed_by(const path *st) { return st->depth ? PT_SLOT(st->depth - 1, PT_SLOT_DIRECTION) : 0u; }
+
 /* L += beta * le * w / mean(R), a contribution of technique `term` (MURK_PT_TERM_*: pathtracer.h), which
  * a build with the tap reports (pathtracer_tap.h). */
 static void add_light(path *st, murk_rgb le, float w, int term)
@@ -368,16 +375,18 @@ static float vertex_pdf(const murk_host *h, const vertex *v, murk_vec3 wi)
 static murk_rgb light_sample_value(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v,
                                    const murk_light_sample *ls, murk_rng *rng);
 
-/* Next-event estimation from v with the numbers of slot `slot` (the light choice, then the point),
- * its value times w added to the path as technique `term`: a light point, the transmittance to it, the
- * power heuristic against the vertex's own sampling. */
+/* Next-event estimation from v with the numbers of slot `slot` (the light choice), the point as the
+ * partner (murk_sample_2d_with) of slot `with`, the draw that placed v: so that over a pixel's samples
+ * the light points stratify jointly with the vertices' positions. Its value times w is added to the
+ * path as technique `term`: a light point, the transmittance to it, the power heuristic against the
+ * vertex's own sampling. */
 static void sample_light(const murk_pt *pt, const murk_scene *scene, path *st, const vertex *v, uint32_t slot,
-                         float w, int term, murk_rng *rng)
+                         uint32_t with, float w, int term, murk_rng *rng)
 {
     float u[3];
     murk_sample_seek(rng, slot);
     u[0] = murk_sample_1d(rng);
-    murk_sample_2d(rng, u + 1);
+    murk_sample_2d_with(rng, with, u + 1);
     murk_light_sample ls;
     ls.flags = 0;
     if (w > 0.0f && pt->host->sample_light_with(scene, v->p, u, pt->light_strategy, &ls))
@@ -537,7 +546,8 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     path at = *st; /* the path as if it had scattered at x: beta sigma_s T / p_eq, the equiangular share */
     at.beta = murk_rgb_mul(st->beta, murk_rgb_scale(murk_rgb_mul(m->data->sigma_s, T), dens));
     at.L = murk_rgb1(0.0f);
-    sample_light(pt, scene, &at, &v, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 3), (1.0f - eq_w_ff(sg, t)) / pe,
+    sample_light(pt, scene, &at, &v, PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 3),
+                 PT_SLOT_EQUIANGULAR(st->depth, st->crossings, 2), (1.0f - eq_w_ff(sg, t)) / pe,
                  MURK_PT_TERM_EQUIANGULAR_NEE, rng);
     st->L = murk_rgb_add(st->L, at.L);
 }
@@ -590,8 +600,8 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     vertex v;
     medium_point(&v, murk_madd(st->ray.o, st->ray.d, ev.t), murk_neg(st->ray.d), m);
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
-        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), eq_w_ff(sg, ev.t),
-                     MURK_PT_TERM_MEDIUM_NEE, rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), PT_SLOT_FLIGHT(st->depth, st->crossings),
+                     eq_w_ff(sg, ev.t), MURK_PT_TERM_MEDIUM_NEE, rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
@@ -674,7 +684,8 @@ static int surface_vertex(const murk_pt *pt, const murk_scene *scene, path *st, 
     if (v.wo_local.z <= 0.0f) /* shading normal past wo: keep the material's wo.z >= 0 promise */
         v.wo_local.z = 1e-6f;
     if (pt->nee)
-        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), 1.0f, MURK_PT_TERM_SURFACE_NEE, rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), placed_by(st), 1.0f,
+                     MURK_PT_TERM_SURFACE_NEE, rng);
     float u[3];
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
