@@ -221,41 +221,43 @@ static inline void murk_sample_2d(murk_rng *r, float u[2])
     u[1] = murk_u24_((uint32_t)(ab >> 32));
 }
 /* Sobol dimensions 2 and 3 (Joe and Kuo 2008's third and fourth: x^2 + x + 1 with m = 1, 3 and
- * x^3 + x + 1 with m = 1, 3, 1), four index bits at a time: entry [n][v] is the XOR of both generator
- * matrices' columns 4n..4n+3 that the nibble v selects, dimension 3 in the high word. */
+ * x^3 + x + 1 with m = 1, 3, 1), bit-reversed and four index bits at a time: entry [n][v] is the XOR of
+ * the reversed generator-matrix columns 31 - 4n - b, b = 0..3, for the bits b set in v, dimension 3 in
+ * the high word. Indexed by the nibbles of reverse(i), it gives reverse(sobol2(i)) : reverse(sobol3(i))
+ * with no reversal computed. */
 static const uint64_t murk_sobol23_[8][16] = {
-    {0x0000000000000000ull, 0x8000000080000000ull, 0xc0000000c0000000ull, 0x4000000040000000ull,
-     0x2000000060000000ull, 0xa0000000e0000000ull, 0xe0000000a0000000ull, 0x6000000020000000ull,
-     0x5000000090000000ull, 0xd000000010000000ull, 0x9000000050000000ull, 0x10000000d0000000ull,
-     0x70000000f0000000ull, 0xf000000070000000ull, 0xb000000030000000ull, 0x30000000b0000000ull},
-    {0x0000000000000000ull, 0xf8000000e8000000ull, 0x740000005c000000ull, 0x8c000000b4000000ull,
-     0xa20000008e000000ull, 0x5a00000066000000ull, 0xd6000000d2000000ull, 0x2e0000003a000000ull,
-     0x93000000c5000000ull, 0x6b0000002d000000ull, 0xe700000099000000ull, 0x1f00000071000000ull,
-     0x310000004b000000ull, 0xc9000000a3000000ull, 0x4500000017000000ull, 0xbd000000ff000000ull},
-    {0x0000000000000000ull, 0xd880000068800000ull, 0x254000009cc00000ull, 0xfdc00000f4400000ull,
-     0x59e00000ee600000ull, 0x8160000086e00000ull, 0x7ca0000072a00000ull, 0xa42000001a200000ull,
-     0xe6d0000055900000ull, 0x3e5000003d100000ull, 0xc3900000c9500000ull, 0x1b100000a1d00000ull,
-     0xbf300000bbf00000ull, 0x67b00000d3700000ull, 0x9a70000027300000ull, 0x42f000004fb00000ull},
-    {0x0000000000000000ull, 0x7808000080680000ull, 0xb40c0000c09c0000ull, 0xcc04000040f40000ull,
-     0x8202000060ee0000ull, 0xfa0a0000e0860000ull, 0x360e0000a0720000ull, 0x4e060000201a0000ull,
-     0xc305000090550000ull, 0xbb0d0000103d0000ull, 0x7709000050c90000ull, 0x0f010000d0a10000ull,
-     0x41070000f0bb0000ull, 0x390f000070d30000ull, 0xf50b000030270000ull, 0x8d030000b04f0000ull},
-    {0x0000000000000000ull, 0x208f8000e8808000ull, 0x514740005cc0c000ull, 0x71c8c000b4404000ull,
-     0xfbea20008e606000ull, 0xdb65a00066e0e000ull, 0xaaad6000d2a0a000ull, 0x8a22e0003a202000ull,
-     0x75d93000c5909000ull, 0x5556b0002d101000ull, 0x249e700099505000ull, 0x0411f00071d0d000ull,
-     0x8e3310004bf0f000ull, 0xaebc9000a3707000ull, 0xdf74500017303000ull, 0xfffbd000ffb0b000ull},
-    {0x0000000000000000ull, 0xa08588006868e800ull, 0x914e54009c9c5c00ull, 0x31cbdc00f4f4b400ull,
-     0xdbe79e00eeee8e00ull, 0x7b62160086866600ull, 0x4aa9ca007272d200ull, 0xea2c42001a1a3a00ull,
-     0x25db6d005555c500ull, 0x855ee5003d3d2d00ull, 0xb4953900c9c99900ull, 0x1410b100a1a17100ull,
-     0xfe3cf300bbbb4b00ull, 0x5eb97b00d3d3a300ull, 0x6f72a70027271700ull, 0xcff72f004f4fff00ull},
-    {0x0000000000000000ull, 0x588000808000e880ull, 0xe54000c0c0005cc0ull, 0xbdc000404000b440ull,
-     0x79e0002060008e60ull, 0x216000a0e00066e0ull, 0x9ca000e0a000d2a0ull, 0xc420006020003a20ull,
-     0xb6d000509000c590ull, 0xee5000d010002d10ull, 0x5390009050009950ull, 0x0b100010d00071d0ull,
-     0xcf300070f0004bf0ull, 0x97b000f07000a370ull, 0x2a7000b030001730ull, 0x72f00030b000ffb0ull},
-    {0x0000000000000000ull, 0x800800f8e8006868ull, 0xc00c00745c009c9cull, 0x4004008cb400f4f4ull,
-     0x200200a28e00eeeeull, 0xa00a005a66008686ull, 0xe00e00d6d2007272ull, 0x6006002e3a001a1aull,
-     0x50050093c5005555ull, 0xd00d006b2d003d3dull, 0x900900e79900c9c9ull, 0x1001001f7100a1a1ull,
-     0x700700314b00bbbbull, 0xf00f00c9a300d3d3ull, 0xb00b004517002727ull, 0x300300bdff004f4full},
+    {0x0000000000000000ull, 0xc900a00aaaaa00a3ull, 0x4500400477770071ull, 0x8c00e00edddd00d2ull,
+     0x2e0030033939003aull, 0xe700900993930099ull, 0x6b0070074e4e004bull, 0xa200d00de4e400e8ull,
+     0x1f00100116160017ull, 0xd600b00bbcbc00b4ull, 0x5a00500561610066ull, 0x9300f00fcbcb00c5ull,
+     0x310020022f2f002dull, 0xf80080088585008eull, 0x740060065858005cull, 0xbd00c00cf2f200ffull},
+    {0x0000000000000000ull, 0x0a000b6d09a30009ull, 0x0400079e06710006ull, 0x0e000cf30fd2000full,
+     0x030002a7033a0003ull, 0x090009ca0a99000aull, 0x07000539054b0005ull, 0x0d000e540ce8000cull,
+     0x0100011a01170001ull, 0x0b000a7708b40008ull, 0x0500068407660007ull, 0x0f000de90ec5000eull,
+     0x020003bd022d0002ull, 0x080008d00b8e000bull, 0x06000423045c0004ull, 0x0c000f4e0dff000dull},
+    {0x0000000000000000ull, 0x00b6dba400a3aaaaull, 0x0079e7db00717777ull, 0x00cf3c7f00d2ddddull,
+     0x002a7289003a3939ull, 0x009ca92d00999393ull, 0x00539552004b4e4eull, 0x00e54ef600e8e4e4ull,
+     0x0011a10500171616ull, 0x00a77aa100b4bcbcull, 0x006846de00666161ull, 0x00de9d7a00c5cbcbull,
+     0x003bd38c002d2f2full, 0x008d0828008e8585ull, 0x00423457005c5858ull, 0x00f4eff300fff2f2ull},
+    {0x0000000000000000ull, 0x000c9bae000909a3ull, 0x000457df00060671ull, 0x0008cc71000f0fd2ull,
+     0x0002e28a0003033aull, 0x000e7924000a0a99ull, 0x0006b5550005054bull, 0x000a2efb000c0ce8ull,
+     0x0001f10400010117ull, 0x000d6aaa000808b4ull, 0x0005a6db00070766ull, 0x00093d75000e0ec5ull,
+     0x0003138e0002022dull, 0x000f8820000b0b8eull, 0x000744510004045cull, 0x000bdfff000d0dffull},
+    {0x0000000000000000ull, 0x0000a0c30000aa09ull, 0x0000404100007706ull, 0x0000e0820000dd0full,
+     0x0000302d00003903ull, 0x000090ee0000930aull, 0x0000706c00004e05ull, 0x0000d0af0000e40cull,
+     0x0000101e00001601ull, 0x0000b0dd0000bc08ull, 0x0000505f00006107ull, 0x0000f09c0000cb0eull,
+     0x0000203300002f02ull, 0x000080f00000850bull, 0x0000607200005804ull, 0x0000c0b10000f20dull},
+    {0x0000000000000000ull, 0x00000b67000009aaull, 0x0000079a00000677ull, 0x00000cfd00000fddull,
+     0x000002a400000339ull, 0x000009c300000a93ull, 0x0000053e0000054eull, 0x00000e5900000ce4ull,
+     0x0000011b00000116ull, 0x00000a7c000008bcull, 0x0000068100000761ull, 0x00000de600000ecbull,
+     0x000003bf0000022full, 0x000008d800000b85ull, 0x0000042500000458ull, 0x00000f4200000df2ull},
+    {0x0000000000000000ull, 0x000000c9000000a3ull, 0x0000004500000071ull, 0x0000008c000000d2ull,
+     0x0000002e0000003aull, 0x000000e700000099ull, 0x0000006b0000004bull, 0x000000a2000000e8ull,
+     0x0000001f00000017ull, 0x000000d6000000b4ull, 0x0000005a00000066ull, 0x00000093000000c5ull,
+     0x000000310000002dull, 0x000000f80000008eull, 0x000000740000005cull, 0x000000bd000000ffull},
+    {0x0000000000000000ull, 0x0000000a00000009ull, 0x0000000400000006ull, 0x0000000e0000000full,
+     0x0000000300000003ull, 0x000000090000000aull, 0x0000000700000005ull, 0x0000000d0000000cull,
+     0x0000000100000001ull, 0x0000000b00000008ull, 0x0000000500000007ull, 0x0000000f0000000eull,
+     0x0000000200000002ull, 0x000000080000000bull, 0x0000000600000004ull, 0x0000000c0000000dull},
 };
 
 /* The next 2-D draw as the partner of slot `with`: Sobol dimensions 2 and 3 of that slot's shuffled
@@ -264,7 +266,9 @@ static const uint64_t murk_sobol23_[8][16] = {
  * any dimension): the first 2^k samples of a pixel stratify the pair jointly, e.g. a vertex's light
  * point with the direction or distance that placed the vertex, which two independent slots do not.
  * The partner's own 2-D projection is a (t, k, 2)-net with t <= 2 rather than 0. With
- * MURK_SAMPLER_INDEPENDENT it is murk_sample_2d. Takes the next slot's place (the slot counter advances). */
+ * MURK_SAMPLER_INDEPENDENT it is murk_sample_2d. Takes the next slot's place (the slot counter advances).
+ * u[0] = u24(reverse(lk(reverse(sobol2(i)), lo32(g)))), u[1] the same of sobol3 with hi32(g), g a hash of
+ * the slot's hash; both reversals of the result done as one 64-bit reversal, as in murk_sample_2d. */
 static inline void murk_sample_2d_with(murk_rng *r, uint32_t with, float u[2])
 {
     if (r->sampler != MURK_SAMPLER_SOBOL) {
@@ -273,12 +277,20 @@ static inline void murk_sample_2d_with(murk_rng *r, uint32_t with, float u[2])
     }
     r->dim++;
     uint64_t h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(with + 1u)), x = 0u;
-    uint32_t i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)h)); /* as murk_sample_slot_ */
+    uint32_t ri = murk_lk_hash_(r->rindex, (uint32_t)h); /* reverse(i), i the slot's shuffled index */
     for (int n = 0; n < 8; n++)
-        x ^= murk_sobol23_[n][(i >> (4 * n)) & 15u];
+        x ^= murk_sobol23_[n][(ri >> (4 * n)) & 15u];
     uint64_t g = murk_hash64(h ^ 0xd1b54a32d192ed03ull);
-    u[0] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_reverse_bits32((uint32_t)x), (uint32_t)g)));
-    u[1] = murk_u24_(murk_reverse_bits32(murk_lk_hash_(murk_reverse_bits32((uint32_t)(x >> 32)), (uint32_t)(g >> 32))));
+    uint64_t ab = ((uint64_t)murk_lk_hash_((uint32_t)x, (uint32_t)g) << 32) |
+                  murk_lk_hash_((uint32_t)(x >> 32), (uint32_t)(g >> 32));
+    ab = ((ab >> 1) & 0x5555555555555555ull) | ((ab & 0x5555555555555555ull) << 1);
+    ab = ((ab >> 2) & 0x3333333333333333ull) | ((ab & 0x3333333333333333ull) << 2);
+    ab = ((ab >> 4) & 0x0f0f0f0f0f0f0f0full) | ((ab & 0x0f0f0f0f0f0f0f0full) << 4);
+    ab = ((ab >> 8) & 0x00ff00ff00ff00ffull) | ((ab & 0x00ff00ff00ff00ffull) << 8);
+    ab = ((ab >> 16) & 0x0000ffff0000ffffull) | ((ab & 0x0000ffff0000ffffull) << 16);
+    ab = (ab >> 32) | (ab << 32);
+    u[0] = murk_u24_((uint32_t)ab);
+    u[1] = murk_u24_((uint32_t)(ab >> 32));
 }
 /* The next slot as one number in [0, 1). */
 static inline float murk_sample_1d(murk_rng *r)
