@@ -196,6 +196,19 @@ static inline uint32_t murk_sample_slot_(murk_rng *r, uint32_t *i, uint64_t *h)
     return murk_reverse_bits32(murk_lk_hash_(*i, (uint32_t)(*h >> 32)));
 }
 static inline float murk_u24_(uint32_t x) { return (float)(x >> 8) * (1.0f / 16777216.0f); }
+/* u[0] = u24(reverse(hi32(ab))), u[1] = u24(reverse(lo32(ab))): the two reversals as one of 64 bits
+ * (reversing a:b gives reverse(b):reverse(a)). */
+static inline void murk_u24_pair_(uint64_t ab, float u[2])
+{
+    ab = ((ab >> 1) & 0x5555555555555555ull) | ((ab & 0x5555555555555555ull) << 1);
+    ab = ((ab >> 2) & 0x3333333333333333ull) | ((ab & 0x3333333333333333ull) << 2);
+    ab = ((ab >> 4) & 0x0f0f0f0f0f0f0f0full) | ((ab & 0x0f0f0f0f0f0f0f0full) << 4);
+    ab = ((ab >> 8) & 0x00ff00ff00ff00ffull) | ((ab & 0x00ff00ff00ff00ffull) << 8);
+    ab = ((ab >> 16) & 0x0000ffff0000ffffull) | ((ab & 0x0000ffff0000ffffull) << 16);
+    ab = (ab >> 32) | (ab << 32);
+    u[0] = murk_u24_((uint32_t)ab);
+    u[1] = murk_u24_((uint32_t)(ab >> 32));
+}
 /* The next slot as a point in [0, 1)^2 (24 bits each, never 1). */
 static inline void murk_sample_2d(murk_rng *r, float u[2])
 {
@@ -205,20 +218,12 @@ static inline void murk_sample_2d(murk_rng *r, float u[2])
         return;
     }
     /* u[0] = u24(reverse(lk(i, hi32(h)))), u[1] = u24(reverse(lk(sobol1_reversed(i), lo32(hash(h))))), as
-     * murk_sample_slot_() and murk_sample_1d() compute them, with the two independent reversals done as one
-     * 64-bit reversal of the pair (reversing a:b gives reverse(b):reverse(a)) */
+     * murk_sample_slot_() and murk_sample_1d() compute them, both reversals as one (murk_u24_pair_) */
     uint64_t h = murk_hash64(r->scramble + 0x9e3779b97f4a7c15ull * (uint64_t)(r->dim++ + 1u));
     uint32_t i = murk_reverse_bits32(murk_lk_hash_(r->rindex, (uint32_t)h));
     uint64_t ab = ((uint64_t)murk_lk_hash_(i, (uint32_t)(h >> 32)) << 32) |
                   murk_lk_hash_(murk_sobol1_reversed(i), (uint32_t)murk_hash64(h));
-    ab = ((ab >> 1) & 0x5555555555555555ull) | ((ab & 0x5555555555555555ull) << 1);
-    ab = ((ab >> 2) & 0x3333333333333333ull) | ((ab & 0x3333333333333333ull) << 2);
-    ab = ((ab >> 4) & 0x0f0f0f0f0f0f0f0full) | ((ab & 0x0f0f0f0f0f0f0f0full) << 4);
-    ab = ((ab >> 8) & 0x00ff00ff00ff00ffull) | ((ab & 0x00ff00ff00ff00ffull) << 8);
-    ab = ((ab >> 16) & 0x0000ffff0000ffffull) | ((ab & 0x0000ffff0000ffffull) << 16);
-    ab = (ab >> 32) | (ab << 32);
-    u[0] = murk_u24_((uint32_t)ab);
-    u[1] = murk_u24_((uint32_t)(ab >> 32));
+    murk_u24_pair_(ab, u);
 }
 /* Sobol dimensions 2 and 3 (Joe and Kuo 2008's third and fourth: x^2 + x + 1 with m = 1, 3 and
  * x^3 + x + 1 with m = 1, 3, 1), bit-reversed and four index bits at a time: entry [n][v] is the XOR of
@@ -268,7 +273,7 @@ static const uint64_t murk_sobol23_[8][16] = {
  * The partner's own 2-D projection is a (t, k, 2)-net with t <= 2 rather than 0. With
  * MURK_SAMPLER_INDEPENDENT it is murk_sample_2d. Takes the next slot's place (the slot counter advances).
  * u[0] = u24(reverse(lk(reverse(sobol2(i)), lo32(g)))), u[1] the same of sobol3 with hi32(g), g a hash of
- * the slot's hash; both reversals of the result done as one 64-bit reversal, as in murk_sample_2d. */
+ * the slot's hash; both reversals of the result as one (murk_u24_pair_). */
 static inline void murk_sample_2d_with(murk_rng *r, uint32_t with, float u[2])
 {
     if (r->sampler != MURK_SAMPLER_SOBOL) {
@@ -283,14 +288,7 @@ static inline void murk_sample_2d_with(murk_rng *r, uint32_t with, float u[2])
     uint64_t g = murk_hash64(h ^ 0xd1b54a32d192ed03ull);
     uint64_t ab = ((uint64_t)murk_lk_hash_((uint32_t)x, (uint32_t)g) << 32) |
                   murk_lk_hash_((uint32_t)(x >> 32), (uint32_t)(g >> 32));
-    ab = ((ab >> 1) & 0x5555555555555555ull) | ((ab & 0x5555555555555555ull) << 1);
-    ab = ((ab >> 2) & 0x3333333333333333ull) | ((ab & 0x3333333333333333ull) << 2);
-    ab = ((ab >> 4) & 0x0f0f0f0f0f0f0f0full) | ((ab & 0x0f0f0f0f0f0f0f0full) << 4);
-    ab = ((ab >> 8) & 0x00ff00ff00ff00ffull) | ((ab & 0x00ff00ff00ff00ffull) << 8);
-    ab = ((ab >> 16) & 0x0000ffff0000ffffull) | ((ab & 0x0000ffff0000ffffull) << 16);
-    ab = (ab >> 32) | (ab << 32);
-    u[0] = murk_u24_((uint32_t)ab);
-    u[1] = murk_u24_((uint32_t)(ab >> 32));
+    murk_u24_pair_(ab, u);
 }
 /* The next slot as one number in [0, 1). */
 static inline float murk_sample_1d(murk_rng *r)
