@@ -600,8 +600,8 @@ static int medium_vertex(const murk_pt *pt, const murk_scene *scene, path *st, f
     vertex v;
     medium_point(&v, murk_madd(st->ray.o, st->ray.d, ev.t), murk_neg(st->ray.d), m);
     if (pt->nee) /* with equiangular sampling, the free flight's share (1 without: sg->b = sg->a) */
-        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE), PT_SLOT_FLIGHT(st->depth, st->crossings),
-                     eq_w_ff(sg, ev.t), MURK_PT_TERM_MEDIUM_NEE, rng);
+        sample_light(pt, scene, st, &v, PT_SLOT(st->depth, PT_SLOT_LIGHT_CHOICE),
+                     PT_SLOT_FLIGHT(st->depth, st->crossings), eq_w_ff(sg, ev.t), MURK_PT_TERM_MEDIUM_NEE, rng);
     float u[2], pdf;
     murk_sample_seek(rng, PT_SLOT(st->depth, PT_SLOT_DIRECTION));
     murk_sample_2d(rng, u);
