@@ -39,8 +39,6 @@ static void prim_bounds(const murk_shape *sh, uint32_t t, murk_vec3 *lo, murk_ve
     }
 }
 
-static float maxabs(murk_vec3 v) { return murk_maxf(fabsf(v.x), murk_maxf(fabsf(v.y), fabsf(v.z))); }
-
 static int boxes_meet(murk_vec3 alo, murk_vec3 ahi, murk_vec3 blo, murk_vec3 bhi)
 {
     return alo.x <= bhi.x && blo.x <= ahi.x && alo.y <= bhi.y && blo.y <= ahi.y && alo.z <= bhi.z && blo.z <= ahi.z;
@@ -60,7 +58,7 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
     b->center = sh->center;
     b->radius = sh->radius;
     murk_shape_bounds(sh, &b->lo, &b->hi);
-    float m = 1e-4f * murk_maxf(1.0f, murk_maxf(maxabs(b->lo), maxabs(b->hi)));
+    float m = 1e-4f * murk_maxf(1.0f, murk_maxf(murk_maxabs(b->lo), murk_maxabs(b->hi)));
     murk_vec3 glo = murk_sub(b->lo, murk_v3(m, m, m)), ghi = murk_add(b->hi, murk_v3(m, m, m));
     for (size_t j = 0; j < s->nshapes; j++) {
         const murk_shape *o = &s->shapes[j];

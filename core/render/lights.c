@@ -178,8 +178,6 @@ typedef struct srect {
     murk_vec3 ax, ay, az; /* unit frame */
 } srect;
 
-static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
-
 /* Closer to a rectangle's plane than this (relative to the coordinates' magnitude, as the integrators'
  * ray offsets are) a point is taken to be on it: not on the emitting side, sampled by area. */
 #define PLANE_EPS 1e-4f
@@ -197,7 +195,7 @@ static int srect_setup(const murk_light *l, murk_vec3 p, srect *r)
     r->z0 = murk_dot(d, r->az);
     /* p behind the emitting side, or on the plane up to rounding: a point on the light itself (a hit on
      * its back, rounded to the front) would see the rectangle fill a hemisphere and be lit by it */
-    if (!(r->z0 < -PLANE_EPS * murk_maxf(1.0f, murk_maxf(maxabs(p), maxabs(l->rp0)))))
+    if (!(r->z0 < -PLANE_EPS * murk_maxf(1.0f, murk_maxf(murk_maxabs(p), murk_maxabs(l->rp0)))))
         return 0;
     r->x1 = r->x0 + lx;
     r->y1 = r->y0 + ly;
@@ -237,8 +235,6 @@ static murk_vec3 srect_sample(const srect *r, murk_vec3 p, float su, float sv)
 }
 
 /* ---- sampling -------------------------------------------------------------------------------------- */
-
-
 
 /* 1 - cos(theta_max) of the cone a sphere subtends from distance d > r, accurate when tiny. */
 static float cone_one_minus_cos(float r, float d)

@@ -152,12 +152,10 @@ enum { PT_SLOT_LIGHT_CHOICE, PT_SLOT_LIGHT_POINT, PT_SLOT_DIRECTION, PT_SLOT_LOB
 
 /* ---- small helpers ------------------------------------------------------------------------- */
 
-static float maxabs(murk_vec3 p) { return murk_maxf(fabsf(p.x), murk_maxf(fabsf(p.y), fabsf(p.z))); }
-
 /* p moved off its surface (normal n) to the side dir points to, by 1e-4 of its magnitude (at least). */
 static murk_vec3 offset(murk_vec3 p, murk_vec3 n, murk_vec3 dir)
 {
-    float eps = 1e-4f * murk_maxf(1.0f, maxabs(p));
+    float eps = 1e-4f * murk_maxf(1.0f, murk_maxabs(p));
     return murk_madd(p, n, murk_dot(n, dir) >= 0.0f ? eps : -eps);
 }
 
@@ -204,7 +202,7 @@ static murk_rgb shadow(const murk_pt *pt, const murk_scene *scene, murk_vec3 p, 
                        murk_rgb *pnull)
 {
     const murk_host *h = pt->host;
-    const float end_eps = inf ? 0.0f : 1e-4f * murk_maxf(1.0f, maxabs(q));
+    const float end_eps = inf ? 0.0f : 1e-4f * murk_maxf(1.0f, murk_maxabs(q));
     murk_rgb T = murk_rgb1(1.0f);
     if (pnull)
         *pnull = T;
@@ -515,7 +513,7 @@ static void equiangular(const murk_pt *pt, const murk_scene *scene, path *st, fl
     murk_vec3 oq = murk_sub(q, st->ray.o);
     float delta = murk_dot(oq, st->ray.d);
     float D = murk_length(murk_sub(oq, murk_mul(st->ray.d, delta)));
-    if (!(D > 1e-6f * murk_maxf(1.0f, maxabs(q))))
+    if (!(D > 1e-6f * murk_maxf(1.0f, murk_maxabs(q))))
         return; /* q on the ray's line: free flights alone */
     float th_a = atan2f(a - delta, D), th_b = isfinite(b) ? atan2f(b - delta, D) : 0.5f * MURK_PI;
     if (!(th_b > th_a))

@@ -52,6 +52,8 @@ static inline float murk_v3_get(murk_vec3 a, int i) { return i == 0 ? a.x : (i =
 /* Componentwise minimum and maximum (fminf/fmaxf: a NaN component gives the other's). */
 static inline murk_vec3 murk_vmin(murk_vec3 a, murk_vec3 b) { return murk_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
 static inline murk_vec3 murk_vmax(murk_vec3 a, murk_vec3 b) { return murk_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+/* The largest |component| of v: the scale of a point's coordinates, for offsets and tolerances. */
+static inline float murk_maxabs(murk_vec3 v) { return murk_maxf(fabsf(v.x), murk_maxf(fabsf(v.y), fabsf(v.z))); }
 
 /* Orthonormal basis around unit n (Duff et al. 2017, branchless). */
 static inline void murk_basis(murk_vec3 n, murk_vec3 *t, murk_vec3 *b)
