@@ -52,6 +52,7 @@
  * end at the same t), so the ratio of flights/s is the ratio of tracker steps/s; the bare loop's steps
  * (tentative collisions + majorant cells) per second are printed too. Interleaved rounds as above, timed
  * in the thread's CPU seconds (CLOCK_THREAD_CPUTIME_ID). */
+#include "render/accel.h"
 #include "render/camera.h"
 #include "render/host.h"
 #include "scene/scene.h"
@@ -84,8 +85,8 @@ static double proc_cpu_now(void)
 
 static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
 {
-    struct RTCBounds b;
-    rtcGetSceneBounds(s->rtc, &b);
+    murk_vec3 lo, hi;
+    murk_accel_bounds(s, &lo, &hi);
     murk_rng rng;
     murk_rng_seed(&rng, 1, 2, 3);
     enum { BATCH = 1 << 16 };
@@ -96,9 +97,9 @@ static double raw_embree(const murk_scene *s, double seconds, uint64_t *nrays)
         for (int i = 0; i < BATCH; i++) { /* generate outside the timed part */
             struct RTCRayHit *r = &rays[i];
             float z = 1 - 2 * murk_rng_float(&rng), phi = 2 * MURK_PI * murk_rng_float(&rng), sz = sqrtf(1 - z * z);
-            r->ray.org_x = b.lower_x + (b.upper_x - b.lower_x) * murk_rng_float(&rng);
-            r->ray.org_y = b.lower_y + (b.upper_y - b.lower_y) * murk_rng_float(&rng);
-            r->ray.org_z = b.lower_z + (b.upper_z - b.lower_z) * murk_rng_float(&rng);
+            r->ray.org_x = lo.x + (hi.x - lo.x) * murk_rng_float(&rng);
+            r->ray.org_y = lo.y + (hi.y - lo.y) * murk_rng_float(&rng);
+            r->ray.org_z = lo.z + (hi.z - lo.z) * murk_rng_float(&rng);
             r->ray.dir_x = sz * cosf(phi), r->ray.dir_y = sz * sinf(phi), r->ray.dir_z = z;
             r->ray.tnear = 0, r->ray.tfar = INFINITY, r->ray.time = 0, r->ray.mask = ~0u, r->ray.id = 0, r->ray.flags = 0;
             r->hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -498,17 +499,16 @@ typedef struct segs {
  * surface or boundary (so every flight is inside the room). */
 static void make_segments(const murk_scene *s, segs *g)
 {
-    struct RTCBounds b;
-    rtcGetSceneBounds(s->rtc, &b);
+    murk_vec3 lo, hi;
+    murk_accel_bounds(s, &lo, &hi);
     const murk_host *h = murk_host_table();
     murk_rng rng;
     murk_rng_seed(&rng, 4, 5, 6);
     for (int i = 0; i < NSEG; i++) {
         murk_ray *r = &g->ray[i];
         float z = 1 - 2 * murk_rng_float(&rng), phi = 2 * MURK_PI * murk_rng_float(&rng), sz = sqrtf(1 - z * z);
-        r->o = murk_v3(b.lower_x + (b.upper_x - b.lower_x) * murk_rng_float(&rng),
-                       b.lower_y + (b.upper_y - b.lower_y) * murk_rng_float(&rng),
-                       b.lower_z + (b.upper_z - b.lower_z) * murk_rng_float(&rng));
+        r->o = murk_v3(lo.x + (hi.x - lo.x) * murk_rng_float(&rng), lo.y + (hi.y - lo.y) * murk_rng_float(&rng),
+                       lo.z + (hi.z - lo.z) * murk_rng_float(&rng));
         r->d = murk_v3(sz * cosf(phi), sz * sinf(phi), z);
         r->tmin = 0.0f;
         r->tmax = INFINITY;

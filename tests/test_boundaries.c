@@ -18,8 +18,10 @@
  *               inside it the host answers intersect() and occluded() by a slab test or a quadratic, with
  *               no Embree ray (the thread's ray count stays put), and agrees with Embree on 20000 random
  *               rays each: the same shape, t and p within 2e-5, the normal to 1e-5, the same media and
- *               answers for shortened rays; rays from outside go to Embree. Must-fail: the box declared
- *               empty in the scene with the sphere inside hides the sphere.
+ *               answers for shortened rays; rays from outside go to Embree, whose tree leaves the shape
+ *               out, and the host's entry test finds it (also among two boxes). Must-fail: the box
+ *               declared empty in the scene with the sphere inside hides the sphere; without the entry
+ *               test the box is missing for a ray from outside.
  * In the suite 'long' (long_* tests, 32x32, 8 seeds, 8x8-pixel blocks: 16 blocks, each with the
  * samples of test_boundaries_long's 64x64 blocks, at a quarter of its cost: a block's standard error is
  * about 0.1 % of its value):
@@ -387,25 +389,37 @@ static murk_vec3 uniform_dir(murk_rng *rng)
     return murk_v3(r * cosf(phi), r * sinf(phi), z);
 }
 
-/* Whether the host's answers for r with the scene's empty boxes equal Embree's alone (boxes switched off);
- * *shortcut gets 1 if the first answer traced no Embree ray. Prints the first disagreement. */
-static int eshape_agrees(murk_scene *s, const murk_ray *r, int *shortcut)
+/* The same scene answered by Embree alone: its empty shapes' geometry put back into Embree's tree (the
+ * loader leaves it out) and the host's shortcuts switched off. */
+static murk_scene *eshape_embree(const char *shape, const char *extra)
+{
+    murk_scene *s = eshape_load(shape, extra);
+    for (size_t i = 0; i < s->nempty_shapes; i++)
+        rtcEnableGeometry(rtcGetGeometry(s->rtc, s->empty_shapes[i].geom));
+    rtcCommitScene(s->rtc);
+    s->nempty_shapes = 0;
+    return s;
+}
+
+/* Whether two media or materials (of two loads of one scene) are the one of that name, or both none. */
+#define same_name(x, y) ((x) == NULL ? (y) == NULL : (y) != NULL && strcmp((x)->name, (y)->name) == 0)
+
+/* Whether the host's answers for r with scene s's empty shapes equal Embree's alone on ref (eshape_embree:
+ * the same scene); *shortcut gets 1 if the first answer traced no Embree ray. Prints the disagreement. */
+static int eshape_agrees(murk_scene *s, murk_scene *ref, const murk_ray *r, int *shortcut)
 {
     const murk_host *h = murk_host_table();
     murk_hit a, b;
     uint64_t before = murk_host_thread_rays();
     int fa = h->intersect(s, r, &a), oa = h->occluded(s, r);
     *shortcut = murk_host_thread_rays() == before;
-    size_t n = s->nempty_shapes;
-    s->nempty_shapes = 0;
-    int fb = h->intersect(s, r, &b), ob = h->occluded(s, r);
-    s->nempty_shapes = n;
+    int fb = h->intersect(ref, r, &b), ob = h->occluded(ref, r);
     int ok = fa == fb && oa == ob;
     if (ok && fa) {
         float tol = 2e-5f * murk_maxf(1.0f, b.t);
         ok = a.geom == b.geom && fabsf(a.t - b.t) <= tol && murk_length(murk_sub(a.p, b.p)) <= tol &&
-             murk_dot(a.ng, b.ng) > 0.99999f && a.interior == b.interior && a.exterior == b.exterior &&
-             a.material == b.material && a.light == b.light;
+             murk_dot(a.ng, b.ng) > 0.99999f && same_name(a.interior, b.interior) &&
+             same_name(a.exterior, b.exterior) && same_name(a.material, b.material) && a.light == b.light;
     }
     if (!ok)
         printf("  ray (%g %g %g) -> (%g %g %g), tmax %g: host %d/%d geom %u t %.7g, Embree %d/%d geom %u t %.7g\n",
@@ -415,35 +429,47 @@ static int eshape_agrees(murk_scene *s, const murk_ray *r, int *shortcut)
     return ok;
 }
 
-/* Random rays with origins over a box around the medium shape (most inside it: the shortcut; some outside:
- * Embree), each also cut short before and after its hit: the host's answers against Embree's. Returns the
- * disagreements; *shortcuts and *inside count the rays that traced no Embree ray and those that start
- * strictly inside the shape. */
-static int eshape_rays(murk_scene *s, murk_vec3 lo, murk_vec3 hi, int n, int *shortcuts, int *inside)
+/* Whether o lies inside empty shape e (strictly, for a sphere). */
+static int in_eshape(const murk_empty_shape *e, murk_vec3 o)
 {
-    const murk_empty_shape *e = &s->empty_shapes[0];
+    murk_vec3 oc = murk_sub(o, e->center);
+    return e->sphere ? murk_dot(oc, oc) < e->radius * e->radius
+                     : o.x >= e->lo.x && o.x <= e->hi.x && o.y >= e->lo.y && o.y <= e->hi.y && o.z >= e->lo.z &&
+                           o.z <= e->hi.z;
+}
+
+/* Random rays with origins over a box around the medium shapes (most inside one: the shortcut; the rest
+ * outside: Embree, and the entry test for the shapes Embree's tree leaves out), each also cut short before
+ * and after its hit: the host's answers on s against Embree's alone on ref (eshape_embree). Returns the
+ * disagreements; *shortcuts counts the rays that traced no Embree ray, *inside those that start inside a
+ * shape, *entered those from outside whose first hit is an empty shape. */
+static int eshape_rays(murk_scene *s, murk_scene *ref, murk_vec3 lo, murk_vec3 hi, int n, int *shortcuts,
+                       int *inside, int *entered)
+{
     murk_rng rng;
     murk_rng_seed(&rng, 7, 1, 2);
     int bad = 0;
-    *shortcuts = *inside = 0;
+    *shortcuts = *inside = *entered = 0;
     for (int i = 0; i < n; i++) {
         murk_vec3 o = murk_v3(lo.x + (hi.x - lo.x) * murk_rng_float(&rng), lo.y + (hi.y - lo.y) * murk_rng_float(&rng),
                               lo.z + (hi.z - lo.z) * murk_rng_float(&rng));
         murk_ray r = {o, uniform_dir(&rng), 0.0f, INFINITY};
-        int sc;
-        bad += !eshape_agrees(s, &r, &sc);
+        int sc, in = 0, empty_hit = 0;
+        bad += !eshape_agrees(s, ref, &r, &sc);
         *shortcuts += sc;
         murk_hit hit;
         if (murk_host_table()->intersect(s, &r, &hit)) { /* shortened: ends before the hit, or just past it */
+            for (size_t k = 0; k < s->nempty_shapes; k++)
+                empty_hit |= hit.geom == s->empty_shapes[k].geom;
             r.tmax = 0.5f * hit.t;
-            bad += !eshape_agrees(s, &r, &sc);
+            bad += !eshape_agrees(s, ref, &r, &sc);
             r.tmax = 1.5f * hit.t;
-            bad += !eshape_agrees(s, &r, &sc);
+            bad += !eshape_agrees(s, ref, &r, &sc);
         }
-        murk_vec3 oc = murk_sub(o, e->center);
-        *inside += e->sphere ? murk_dot(oc, oc) < e->radius * e->radius
-                             : o.x >= e->lo.x && o.x <= e->hi.x && o.y >= e->lo.y && o.y <= e->hi.y &&
-                                   o.z >= e->lo.z && o.z <= e->hi.z;
+        for (size_t k = 0; k < s->nempty_shapes; k++)
+            in |= in_eshape(&s->empty_shapes[k], o);
+        *inside += in;
+        *entered += !in && empty_hit;
     }
     return bad;
 }
@@ -480,22 +506,26 @@ static void test_empty_box(void **state)
         assert_int_equal(first, found[i].first);
         murk_scene_free(s);
     }
-    /* origins over a box a little larger than the shape's bounds */
-    static const struct { const char *label, *shape; float lo[3], hi[3]; } rays[] = {
-        {"box", EBOX, {-0.65f, 0.05f, -0.55f}, {0.75f, 1.35f, 0.45f}},
-        {"sphere", ESPHERE, {-0.55f, 0.1f, -0.65f}, {0.65f, 1.3f, 0.55f}},
+    /* origins over a box a little larger than the shapes' bounds */
+    static const struct { const char *label, *shape, *extra; float lo[3], hi[3]; } rays[] = {
+        {"box", EBOX, "", {-0.65f, 0.05f, -0.55f}, {0.75f, 1.35f, 0.45f}},
+        {"sphere", ESPHERE, "", {-0.55f, 0.1f, -0.65f}, {0.65f, 1.3f, 0.55f}},
+        {"two boxes", EBOX, "  - { type: box, min: [0.8, 0.05, 0], max: [0.9, 0.2, 0.1], interior: m }\n",
+         {-0.65f, 0.0f, -0.55f}, {0.95f, 1.35f, 0.45f}},
     };
     murk_scene *s = NULL;
     for (size_t i = 0; i < sizeof rays / sizeof rays[0]; i++) {
         const int N = 20000;
-        int shortcuts, inside;
-        murk_scene *e = eshape_load(rays[i].shape, "");
-        int bad = eshape_rays(e, murk_v3(rays[i].lo[0], rays[i].lo[1], rays[i].lo[2]),
-                              murk_v3(rays[i].hi[0], rays[i].hi[1], rays[i].hi[2]), N, &shortcuts, &inside);
-        printf("empty %s: %d rays, %d from inside it, %d answered without Embree, %d disagreements\n", rays[i].label,
-               N, inside, shortcuts, bad);
+        int shortcuts, inside, entered;
+        murk_scene *e = eshape_load(rays[i].shape, rays[i].extra), *ref = eshape_embree(rays[i].shape, rays[i].extra);
+        int bad = eshape_rays(e, ref, murk_v3(rays[i].lo[0], rays[i].lo[1], rays[i].lo[2]),
+                              murk_v3(rays[i].hi[0], rays[i].hi[1], rays[i].hi[2]), N, &shortcuts, &inside, &entered);
+        printf("empty %s: %d rays, %d from inside, %d answered without Embree, %d from outside entering one, "
+               "%d disagreements\n", rays[i].label, N, inside, shortcuts, entered, bad);
         assert_int_equal(bad, 0);
         assert_int_equal(shortcuts, inside);
+        assert_true(entered > N / 50); /* the entry test is exercised */
+        murk_scene_free(ref);
         if (i == 0)
             s = e; /* the box, for the must-fail below */
         else
@@ -504,18 +534,32 @@ static void test_empty_box(void **state)
     /* must fail: the same box declared empty where a sphere sits inside hides the sphere from a ray aimed
      * at it (the detection above is what prevents this) */
     murk_scene *t = eshape_load(EBOX, "  - { type: sphere, center: [0, 0.7, 0], radius: 0.1, material: white }\n");
+    murk_scene *tref = eshape_embree(EBOX, "  - { type: sphere, center: [0, 0.7, 0], radius: 0.1, material: white }\n");
     assert_int_equal(t->nempty_shapes, 0);
     murk_empty_shape wrong = s->empty_shapes[0];
     t->empty_shapes = &wrong;
     t->nempty_shapes = 1;
     murk_ray at_sphere = {murk_v3(0.5f, 0.7f, 0.0f), murk_v3(-1.0f, 0.0f, 0.0f), 0.0f, INFINITY};
     int sc;
-    int agrees = eshape_agrees(t, &at_sphere, &sc);
+    int agrees = eshape_agrees(t, tref, &at_sphere, &sc);
     printf("must fail: a box wrongly declared empty around a sphere %s\n", agrees ? "went unnoticed" : "is seen");
     assert_false(agrees);
     t->empty_shapes = NULL;
     t->nempty_shapes = 0;
+    /* must fail: without its entry test the box is missing for a ray from outside (Embree's tree leaves it
+     * out), which the comparison sees */
+    murk_scene *sref = eshape_embree(EBOX, "");
+    murk_ray at_box = {murk_v3(0.0f, 0.7f, 2.0f), murk_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY};
+    assert_true(eshape_agrees(s, sref, &at_box, &sc));
+    size_t n = s->nempty_shapes;
+    s->nempty_shapes = 0;
+    agrees = eshape_agrees(s, sref, &at_box, &sc);
+    s->nempty_shapes = n;
+    printf("must fail: the box without its entry test %s\n", agrees ? "went unnoticed" : "is seen");
+    assert_false(agrees);
+    murk_scene_free(sref);
     murk_scene_free(t);
+    murk_scene_free(tref);
     murk_scene_free(s);
 }
 

@@ -148,11 +148,6 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
             return -1;
         }
     }
-    rtcCommitScene(s->rtc);
-    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
-        murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
-        return -1;
-    }
     free(s->empty_shapes);
     s->empty_shapes = NULL;
     s->nempty_shapes = 0;
@@ -168,6 +163,26 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
         if (!s->empty_shapes)
             s->empty_shapes = murk_xmalloc(MURK_EMPTY_SHAPE_MAX * sizeof *s->empty_shapes);
         s->empty_shapes[s->nempty_shapes++] = b;
+        /* host.c answers every ray's meeting with it: Embree's tree leaves it out, so that the rays
+         * that pass it or cross it do not traverse it */
+        rtcDisableGeometry(rtcGetGeometry(s->rtc, b.geom));
+    }
+    rtcCommitScene(s->rtc);
+    if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
+        murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
+        return -1;
     }
     return 0;
+}
+
+void murk_accel_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi)
+{
+    struct RTCBounds b;
+    rtcGetSceneBounds(s->rtc, &b);
+    *lo = murk_v3(b.lower_x, b.lower_y, b.lower_z);
+    *hi = murk_v3(b.upper_x, b.upper_y, b.upper_z);
+    for (size_t i = 0; i < s->nempty_shapes; i++) {
+        *lo = murk_vmin(*lo, s->empty_shapes[i].lo);
+        *hi = murk_vmax(*hi, s->empty_shapes[i].hi);
+    }
 }

@@ -43,7 +43,10 @@ static inline murk_vec3 murk_triangle_normal(murk_vec3 a, murk_vec3 b, murk_vec3
  * its bounds. A ray that starts inside it meets its surface before anything else, so host.c finds that
  * point by a slab test (a box) or the far root of a quadratic (a sphere) instead of asking Embree: the
  * free flights and shadow rays from the scattering events of a medium in a box or a sphere, the
- * commonest medium setups, cost no traversal. At most MURK_EMPTY_SHAPE_MAX per scene (each costs every
+ * commonest medium setups, cost no traversal. Nothing else lies within its bounds either, so a ray from
+ * outside meets it where the same test (the near root of a sphere) says, unless Embree finds a surface
+ * first: its geometry is left out of Embree's tree (disabled), and every ray that passes or crosses it
+ * traverses a smaller tree. At most MURK_EMPTY_SHAPE_MAX per scene (each costs every
  * ray an inside test), found among the first 2 x MURK_EMPTY_SHAPE_MAX medium boxes and spheres (each is
  * checked against every primitive at load). */
 enum { MURK_EMPTY_SHAPE_MAX = 8 };
@@ -62,5 +65,8 @@ typedef struct murk_empty_shape {
 
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium shapes. */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
+/* The bounds of every shape's primitives: Embree's tree's and the empty medium shapes' (which it leaves
+ * out). Empty (lo > hi) for a scene without shapes. */
+void murk_accel_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi);
 
 #endif

@@ -204,6 +204,68 @@ static const murk_empty_shape *shape_exit(const murk_scene *s, const murk_ray *r
     return NULL;
 }
 
+/* Where a ray from a point outside sphere (center, radius) enters it: the near root, c / (q - b) (the
+ * form that does not cancel); +inf when it does not meet it ahead. */
+static float sphere_entry(murk_vec3 center, float radius, const murk_ray *r)
+{
+    murk_vec3 oc = murk_sub(r->o, center);
+    float c = murk_dot(oc, oc) - radius * radius, a = murk_dot(r->d, r->d), b = murk_dot(r->d, oc);
+    float disc = b * b - a * c;
+    if (!(c > 0.0f) || !(b < 0.0f) || !(disc >= 0.0f))
+        return INFINITY;
+    return c / (sqrtf(disc) - b);
+}
+
+/* Where a ray (origin o, inverse direction inv) from a point outside box b enters it: the slab test, the
+ * last plane entered if before the first left; +inf when it does not meet it ahead. Branch-free: every
+ * ray that reaches Embree takes it (a zero direction component gives +-inf per slab, or NaN for an
+ * origin exactly on that slab's plane, where the ray runs in the plane and either answer is right). */
+static float box_entry(const murk_empty_shape *b, murk_vec3 o, murk_vec3 inv)
+{
+    float x0 = (b->lo.x - o.x) * inv.x, x1 = (b->hi.x - o.x) * inv.x;
+    float y0 = (b->lo.y - o.y) * inv.y, y1 = (b->hi.y - o.y) * inv.y;
+    float z0 = (b->lo.z - o.z) * inv.z, z1 = (b->hi.z - o.z) * inv.z;
+    float tin = murk_maxf(murk_maxf(murk_minf(x0, x1), murk_minf(y0, y1)), murk_minf(z0, z1));
+    float tout = murk_minf(murk_minf(murk_maxf(x0, x1), murk_maxf(y0, y1)), murk_maxf(z0, z1));
+    return tin <= tout ? tin : INFINITY;
+}
+
+/* The face (box_exit's numbering) of box b through which the ray (o, inv) enters it at tin: the slab
+ * whose near plane is tin, entered from its -a side when moving towards +a. */
+static int box_entry_face(const murk_empty_shape *b, murk_vec3 o, murk_vec3 inv, float tin)
+{
+    int face = -1;
+    float best = INFINITY;
+    for (int a = 0; a < 3; a++) {
+        float ia = murk_v3_get(inv, a), oa = murk_v3_get(o, a);
+        float t = ((ia > 0.0f ? murk_v3_get(b->lo, a) : murk_v3_get(b->hi, a)) - oa) * ia;
+        if (fabsf(t - tin) < best) {
+            best = fabsf(t - tin);
+            face = 2 * a + (ia > 0.0f ? 1 : 0);
+        }
+    }
+    return face;
+}
+
+/* The empty medium shape that a ray from outside all of them meets first within (tmin, tmax], the
+ * distance *t and (a box) the face *face; NULL if none. */
+static const murk_empty_shape *shape_entry(const murk_scene *s, const murk_ray *r, float tmax, float *t, int *face)
+{
+    const murk_empty_shape *first = NULL;
+    const murk_vec3 inv = murk_v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
+    for (size_t i = 0; i < s->nempty_shapes; i++) {
+        const murk_empty_shape *b = &s->empty_shapes[i];
+        float te = b->sphere ? sphere_entry(b->center, b->radius, r) : box_entry(b, r->o, inv);
+        if (te > r->tmin && te <= tmax && te < INFINITY) { /* +inf: it misses */
+            first = b;
+            tmax = *t = te;
+        }
+    }
+    if (first)
+        *face = first->sphere ? -1 : box_entry_face(first, r->o, inv, *t);
+    return first;
+}
+
 /* Barycentrics (b1, b2) of p in box triangle bt, clamped into the triangle; returns the smallest of the
  * three before clamping (negative: p lies outside by that much). */
 static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float *b2)
@@ -217,10 +279,10 @@ static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float 
     return least;
 }
 
-/* The hit where r leaves shape b at t (a box: through face f), as Embree would report it: a sphere's
- * only primitive; a box face's triangle that holds the point (the first unless the point lies outside
- * it) and its barycentrics. */
-static void exit_hit(const murk_scene *s, const murk_ray *r, const murk_empty_shape *b, float t, int f, murk_hit *h)
+/* The hit where r meets shape b at t (a box: on face f), leaving or entering it, as Embree would report
+ * it: a sphere's only primitive; a box face's triangle that holds the point (the first unless the point
+ * lies outside it) and its barycentrics. */
+static void shape_hit(const murk_scene *s, const murk_ray *r, const murk_empty_shape *b, float t, int f, murk_hit *h)
 {
     float u = 0.0f, v = 0.0f, u1, v1;
     int k = 0;
@@ -252,21 +314,30 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     if (b) {
         if (!(te <= r->tmax))
             return 0;
-        exit_hit(s, r, b, te, face, h);
+        shape_hit(s, r, b, te, face, h);
         return 1;
     }
+    /* the empty shapes are not in Embree's tree (accel.h): the first one the ray enters is the answer
+     * unless Embree finds a surface before it, so Embree searches only up to there */
+    b = s->nempty_shapes ? shape_entry(s, r, r->tmax, &te, &face) : NULL;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
     to_embree(r, &rh.ray);
+    if (b)
+        rh.ray.tfar = te;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     murk_tally()->rays++;
     if (ray_record)
         record_ray(r, 0);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-        return 0;
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        if (!b)
+            return 0;
+        shape_hit(s, r, b, te, face, h);
+        return 1;
+    }
     fill_hit(s, r, &rh, h);
     return 1;
 }
@@ -279,6 +350,8 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     int face;
     if (s->nempty_shapes && shape_exit(s, r, &te, &face)) /* nothing inside: only its own surface occludes */
         return te <= r->tmax;
+    if (s->nempty_shapes && shape_entry(s, r, r->tmax, &te, &face)) /* not in Embree's tree (accel.h) */
+        return 1;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRay er;

@@ -27,15 +27,15 @@ static void add_light(murk_scene *s, size_t *cap, const murk_light *l)
     s->lights[s->nlights++] = *l;
 }
 
-/* The centre and radius of the scene's bounding sphere: the Embree scene's box (the origin and 1 when
+/* The radius of the scene's bounding sphere: the shapes' box, murk_accel_bounds (1 when
  * the scene has no shapes). */
 static double scene_radius(const murk_scene *s)
 {
-    struct RTCBounds b;
-    rtcGetSceneBounds(s->rtc, &b);
-    if (!(b.upper_x >= b.lower_x && b.upper_y >= b.lower_y && b.upper_z >= b.lower_z))
+    murk_vec3 lo, hi;
+    murk_accel_bounds(s, &lo, &hi);
+    if (!(hi.x >= lo.x && hi.y >= lo.y && hi.z >= lo.z))
         return 1.0;
-    double dx = (double)b.upper_x - b.lower_x, dy = (double)b.upper_y - b.lower_y, dz = (double)b.upper_z - b.lower_z;
+    double dx = (double)hi.x - lo.x, dy = (double)hi.y - lo.y, dz = (double)hi.z - lo.z;
     double r = 0.5 * sqrt(dx * dx + dy * dy + dz * dz);
     return r > 0.0 ? r : 1.0;
 }
