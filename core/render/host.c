@@ -320,18 +320,19 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     /* the empty shapes are not in Embree's tree (accel.h): the first one the ray enters is the answer
      * unless Embree finds a surface before it, so Embree searches only up to there */
     b = s->nempty_shapes ? shape_entry(s, r, r->tmax, &te, &face) : NULL;
+    murk_ray asked = *r; /* what Embree is asked (and a recording replays) */
+    if (b)
+        asked.tmax = te;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    to_embree(r, &rh.ray);
-    if (b)
-        rh.ray.tfar = te;
+    to_embree(&asked, &rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(s->rtc, &ctx, &rh);
     murk_tally()->rays++;
     if (ray_record)
-        record_ray(r, 0);
+        record_ray(&asked, 0);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         if (!b)
             return 0;
