@@ -418,8 +418,10 @@ static int eshape_agrees(murk_scene *s, murk_scene *ref, const murk_ray *r, int 
     if (ok && fa) {
         float tol = 2e-5f * murk_maxf(1.0f, b.t);
         ok = a.geom == b.geom && fabsf(a.t - b.t) <= tol && murk_length(murk_sub(a.p, b.p)) <= tol &&
-             murk_dot(a.ng, b.ng) > 0.99999f && same_name(a.interior, b.interior) &&
-             same_name(a.exterior, b.exterior) && same_name(a.material, b.material) && a.light == b.light;
+             murk_dot(a.ng, b.ng) > 0.99999f && murk_dot(a.n, b.n) > 0.99999f && fabsf(a.u - b.u) <= 1e-4f &&
+             fabsf(a.v - b.v) <= 1e-4f && same_name(a.interior, b.interior) && same_name(a.exterior, b.exterior) &&
+             same_name(a.material, b.material) && a.light == b.light &&
+             memcmp(a.emission.c, b.emission.c, sizeof a.emission.c) == 0;
     }
     if (!ok)
         printf("  ray (%g %g %g) -> (%g %g %g), tmax %g: host %d/%d geom %u t %.7g, Embree %d/%d geom %u t %.7g\n",
@@ -556,6 +558,21 @@ static void test_empty_box(void **state)
     agrees = eshape_agrees(s, sref, &at_box, &sc);
     s->nempty_shapes = n;
     printf("must fail: the box without its entry test %s\n", agrees ? "went unnoticed" : "is seen");
+    assert_false(agrees);
+    /* must fail: the faces' copies of their corners' (u, v), from which the host fills a hit on the box
+     * (accel.h, plain), with u and v swapped: the hit's (u, v) differ from Embree's (0.46, 0.5 there) */
+    assert_true(s->empty_shapes[0].plain);
+    murk_empty_shape keep = s->empty_shapes[0];
+    for (int f = 0; f < 6; f++)
+        for (int k = 0; k < 2; k++)
+            for (int c = 0; c < 3; c++) {
+                float *uv = &s->empty_shapes[0].tri[f][k].uv[2 * c], u0 = uv[0];
+                uv[0] = uv[1];
+                uv[1] = u0;
+            }
+    agrees = eshape_agrees(s, sref, &at_box, &sc);
+    s->empty_shapes[0] = keep;
+    printf("must fail: the box's (u, v) swapped in its faces' copies %s\n", agrees ? "went unnoticed" : "is seen");
     assert_false(agrees);
     murk_scene_free(sref);
     murk_scene_free(t);

@@ -71,6 +71,7 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
     }
     int n[6] = {0};
     b->geom = (uint32_t)i;
+    b->plain = !b->sphere && sh->uv && !sh->nrm && !sh->emission_tex;
     for (uint32_t t = 0; !b->sphere && t < 12; t++) {
         const float *g = &sh->ng[3 * t];
         int a = fabsf(g[0]) > 0.5f ? 0 : (fabsf(g[1]) > 0.5f ? 1 : 2);
@@ -82,7 +83,12 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
         murk_box_tri *bt = &b->tri[f][n[f]++];
         bt->prim = t;
         bt->a = murk_shape_vertex(sh, tv[0]);
-        murk_vec3 e1 = murk_sub(murk_shape_vertex(sh, tv[1]), bt->a), e2 = murk_sub(murk_shape_vertex(sh, tv[2]), bt->a);
+        bt->b = murk_shape_vertex(sh, tv[1]);
+        bt->c = murk_shape_vertex(sh, tv[2]);
+        bt->ng = murk_v3(g[0], g[1], g[2]);
+        for (int k = 0; k < 6 && sh->uv; k++)
+            bt->uv[k] = sh->uv[2 * tv[k / 2] + (uint32_t)(k % 2)];
+        murk_vec3 e1 = murk_sub(bt->b, bt->a), e2 = murk_sub(bt->c, bt->a);
         float d11 = murk_dot(e1, e1), d12 = murk_dot(e1, e2), d22 = murk_dot(e2, e2), det = d11 * d22 - d12 * d12;
         if (!(det > 0.0f))
             return 0;

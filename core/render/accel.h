@@ -53,11 +53,14 @@ enum { MURK_EMPTY_SHAPE_MAX = 8 };
 typedef struct murk_box_tri {
     uint32_t prim;     /* the triangle's index in its shape */
     murk_vec3 a, g1, g2; /* its first corner and dual edge vectors: barycentrics (b1, b2) = ((p-a).g1, (p-a).g2) */
+    murk_vec3 b, c, ng;  /* its other corners and its stored unit normal (murk_shape.ng), and */
+    float uv[6];         /* its corners' (u, v): host.c fills a hit on it without the shape's arrays */
 } murk_box_tri;
 typedef struct murk_empty_shape {
     murk_vec3 lo, hi;       /* its bounds */
     uint32_t geom;          /* the shape's index (its Embree geometry id) */
     int sphere;             /* 1: a sphere (center, radius), else a box (tri) */
+    int plain;              /* a box with uv and without shading normals or an emission texture: hits from tri alone */
     murk_vec3 center;
     float radius;
     murk_box_tri tri[6][2]; /* a box: the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */

@@ -55,6 +55,36 @@ static void host_log(int level, const char *fmt, ...)
 
 static void host_tex_eval(const murk_texture *t, const murk_hit *hit, float out[3]) { murk_texture_eval(t, hit, out); }
 
+/* The point of triangle (a, b, c) at barycentrics (b1, b2). */
+static murk_vec3 tri_point(murk_vec3 a, murk_vec3 b, murk_vec3 c, float b1, float b2)
+{
+    float b0 = 1.0f - b1 - b2;
+    return murk_add(murk_add(murk_mul(a, b0), murk_mul(b, b1)), murk_mul(c, b2));
+}
+
+/* The (u, v) of a triangle whose corners have t0, t1, t2, at barycentrics (b1, b2). */
+static void tri_uv(const float *t0, const float *t1, const float *t2, float b1, float b2, murk_hit *h)
+{
+    float b0 = 1.0f - b1 - b2;
+    h->u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
+    h->v = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
+}
+
+/* What a hit on shape sh takes from the shape once t, p, the normals, (u, v), geom and prim are set. */
+static void hit_shape_fields(const murk_shape *sh, murk_hit *h)
+{
+    h->material = sh->material;
+    h->interior = sh->interior;
+    h->exterior = sh->exterior;
+    h->emission = sh->emission;
+    if (sh->emission_tex) {
+        float t[3];
+        murk_texture_eval(sh->emission_tex, h, t);
+        h->emission = murk_rgb3(sh->emission.c[0] * t[0], sh->emission.c[1] * t[1], sh->emission.c[2] * t[2]);
+    }
+    h->light = sh->light_base < 0 ? -1 : sh->light_base + (sh->type == MURK_SHAPE_SPHERE ? 0 : (int32_t)h->prim);
+}
+
 static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRayHit *rh, murk_hit *h)
 {
     const murk_shape *sh = &s->shapes[rh->hit.geomID];
@@ -75,7 +105,7 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
         const size_t i0 = ix[0], i1 = ix[1], i2 = ix[2];
         float b1 = rh->hit.u, b2 = rh->hit.v, b0 = 1.0f - b1 - b2;
         murk_vec3 a = murk_shape_vertex(sh, i0), b = murk_shape_vertex(sh, i1), c = murk_shape_vertex(sh, i2);
-        h->p = murk_add(murk_add(murk_mul(a, b0), murk_mul(b, b1)), murk_mul(c, b2));
+        h->p = tri_point(a, b, c, b1, b2);
         const float *ng = sh->ng ? &sh->ng[3 * (size_t)h->prim] : NULL;
         h->ng = ng ? murk_v3(ng[0], ng[1], ng[2]) : murk_triangle_normal(a, b, c);
         h->n = h->ng;
@@ -87,24 +117,13 @@ static void fill_hit(const murk_scene *s, const murk_ray *r, const struct RTCRay
                 h->n = murk_dot(ns, h->ng) < 0.0f ? murk_neg(ns) : ns;
         }
         if (sh->uv) {
-            const float *t0 = &sh->uv[2 * i0], *t1 = &sh->uv[2 * i1], *t2 = &sh->uv[2 * i2];
-            h->u = b0 * t0[0] + b1 * t1[0] + b2 * t2[0];
-            h->v = b0 * t0[1] + b1 * t1[1] + b2 * t2[1];
+            tri_uv(&sh->uv[2 * i0], &sh->uv[2 * i1], &sh->uv[2 * i2], b1, b2, h);
         } else {
             h->u = b1;
             h->v = b2;
         }
     }
-    h->material = sh->material;
-    h->interior = sh->interior;
-    h->exterior = sh->exterior;
-    h->emission = sh->emission;
-    if (sh->emission_tex) {
-        float t[3];
-        murk_texture_eval(sh->emission_tex, h, t);
-        h->emission = murk_rgb3(sh->emission.c[0] * t[0], sh->emission.c[1] * t[1], sh->emission.c[2] * t[2]);
-    }
-    h->light = sh->light_base < 0 ? -1 : sh->light_base + (sh->type == MURK_SHAPE_SPHERE ? 0 : (int32_t)h->prim);
+    hit_shape_fields(sh, h);
 }
 
 static void to_embree(const murk_ray *r, struct RTCRay *er)
@@ -294,6 +313,17 @@ static void shape_hit(const murk_scene *s, const murk_ray *r, const murk_empty_s
             u = u1;
             v = v1;
         }
+    }
+    if (b->plain) { /* fill_hit's result from the face's own copy of its triangle */
+        const murk_box_tri *bt = &b->tri[f][k];
+        h->t = t;
+        h->geom = b->geom;
+        h->prim = bt->prim;
+        h->p = tri_point(bt->a, bt->b, bt->c, u, v);
+        h->ng = h->n = bt->ng;
+        tri_uv(&bt->uv[0], &bt->uv[2], &bt->uv[4], u, v, h);
+        hit_shape_fields(&s->shapes[b->geom], h);
+        return;
     }
     struct RTCRayHit rh;
     rh.ray.tfar = t;
