@@ -7,7 +7,9 @@
  * media, boundaries, spheres, shading normals or textures) the bare tracer's five rungs, each run for
  * the given CPU seconds per round:
  *   raw     random incoherent rays — origins uniform in the scene's bounding box, directions uniform on
- *           the sphere — through rtcIntersect1 alone (the yardstick of "murk reaches X % of raw Embree");
+ *           the sphere — through rtcIntersect1 alone (the yardstick of "murk reaches X % of raw Embree"),
+ *           on the tree murk renders with (without the empty medium shapes and a scene's few spheres,
+ *           which murk's host tests itself: render/accel.h);
  *   replay  the rays murk itself traced in a 4-spp render of the scene (recorded by host.c,
  *           murk_host_record_rays), traced again in the same order with the same calls: rtcIntersect1
  *           for camera, BSDF and boundary rays, rtcOccluded1 for shadow rays, a fresh context per ray as

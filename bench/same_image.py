@@ -9,7 +9,8 @@ For changes that alter pixels but must not alter the expectation (another order 
 numbers, a faster log in free-flight sampling, ...): the build before the change (--old) and the build
 with it (--new) render the three scenes of tests/test_roulette_long.c — scenes/cornell.yaml (path),
 scenes/cornell_smoke.yaml (its cloud, volpath_nee) and a constant chromatic medium in the same box
-(delta tracking) — --seeds times each at --res x --res and --spp, on 2 threads, old and new with
+(delta tracking) — and the Cornell box with a sphere for its short block (a scene's few spheres are
+intersected by murk's host, not Embree) --seeds times each at --res x --res and --spp, on 2 threads, old and new with
 different seeds so that their estimates are independent. Then, per scene, the block-wise z-test of
 tests/testutil.c's img_stack_agree, mirrored here: per pixel and channel (r, g, b and their average)
 the mean over the seeds and the variance of that mean; per block of --block x --block pixels and
@@ -46,7 +47,7 @@ import exrio  # noqa: E402
 STAT_Z = 5.0  # tests/stat.h
 MIN_BLOCKS = 16  # tests/testutil.c: fewer blocks with signal is too little to judge
 
-# tests/test_roulette_long.c's three cases: (label, scene file, its --set overrides)
+# tests/test_roulette_long.c's three cases and a sphere: (label, scene file, its --set overrides)
 SCENES = [
     ("cornell", "cornell.yaml", []),
     ("cornell_smoke", "cornell_smoke.yaml", []),
@@ -54,6 +55,8 @@ SCENES = [
      ["--set", "media.smoke.type=delta", "--set", "media.smoke.density={constant: 1}",
       "--set", "media.smoke.sigma_a=[0.05, 0.1, 0.3]", "--set", "media.smoke.sigma_s=[1.2, 0.8, 0.4]",
       "--set", "media.smoke.g=0.2"]),
+    ("cornell, a sphere", "cornell.yaml",
+     ["--set", "shapes.7={type: sphere, center: [0.35, 0.3, 0.25], radius: 0.3, material: white}"]),
 ]
 BRIGHTER = ["--set", "shapes.5.emission=[17.17, 12.12, 4.04]"]  # the lamp of both scenes, 1.01 x
 SEED0 = {"old": 100, "new": 200, "bright": 300}  # disjoint seeds: independent estimates

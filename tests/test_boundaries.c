@@ -389,15 +389,18 @@ static murk_vec3 uniform_dir(murk_rng *rng)
     return murk_v3(r * cosf(phi), r * sinf(phi), z);
 }
 
-/* The same scene answered by Embree alone: its empty shapes' geometry put back into Embree's tree (the
- * loader leaves it out) and the host's shortcuts switched off. */
+/* The same scene answered by Embree alone: its empty shapes' and few spheres' geometry put back into
+ * Embree's tree (the loader leaves it out) and the host's shortcuts switched off. */
 static murk_scene *eshape_embree(const char *shape, const char *extra)
 {
     murk_scene *s = eshape_load(shape, extra);
     for (size_t i = 0; i < s->nempty_shapes; i++)
         rtcEnableGeometry(rtcGetGeometry(s->rtc, s->empty_shapes[i].geom));
+    for (size_t i = 0; i < s->nfew_spheres; i++)
+        rtcEnableGeometry(rtcGetGeometry(s->rtc, s->few_spheres[i]));
     rtcCommitScene(s->rtc);
     s->nempty_shapes = 0;
+    s->nfew_spheres = 0;
     return s;
 }
 
@@ -580,12 +583,70 @@ static void test_empty_box(void **state)
     murk_scene_free(s);
 }
 
+/* A scene's few spheres (render/accel.h) are intersected by the host, not Embree: its answers against
+ * Embree's with the spheres put back, for random rays from inside and outside them. */
+static void test_few_spheres(void **state)
+{
+    (void)state;
+    /* shape 1 and the rest: a sphere, one overlapping it, a medium sphere with a quad inside (not empty) */
+    static const char *first = "  - { type: sphere, center: [0, 0.5, 0], radius: 0.4, material: white }\n";
+    static const char *rest =
+        "  - { type: sphere, center: [0.3, 0.65, 0.1], radius: 0.2, material: white }\n"
+        "  - { type: sphere, center: [-0.5, 1.0, -0.3], radius: 0.3, interior: m }\n"
+        "  - { type: quad, center: [-0.5, 1.0, -0.3], u: [0.1, 0, 0], v: [0, 0, 0.1], material: white }\n";
+    murk_scene *s = eshape_load(first, rest), *ref = eshape_embree(first, rest);
+    printf("few spheres: %zu host-intersected spheres (expected 3), %zu empty shapes\n", s->nfew_spheres,
+           s->nempty_shapes);
+    assert_int_equal(s->nfew_spheres, 3);
+    assert_int_equal(s->nempty_shapes, 0);
+    const int N = 20000;
+    int shortcuts, inside, entered;
+    int bad = eshape_rays(s, ref, murk_v3(-0.9f, -0.1f, -0.7f), murk_v3(0.6f, 1.4f, 0.6f), N, &shortcuts, &inside,
+                          &entered);
+    /* how many of those rays the spheres answer (the same rays: eshape_rays' seed) */
+    murk_rng rng;
+    murk_rng_seed(&rng, 7, 1, 2);
+    int on_sphere = 0;
+    for (int i = 0; i < N; i++) {
+        murk_vec3 o = murk_v3(-0.9f + 1.5f * murk_rng_float(&rng), -0.1f + 1.5f * murk_rng_float(&rng),
+                              -0.7f + 1.3f * murk_rng_float(&rng));
+        murk_ray r = {o, uniform_dir(&rng), 0.0f, INFINITY};
+        murk_hit hit;
+        on_sphere += murk_host_table()->intersect(s, &r, &hit) && s->shapes[hit.geom].type == MURK_SHAPE_SPHERE;
+    }
+    printf("few spheres: %d rays, %d hit a sphere, %d answered without Embree, %d disagreements\n", N, on_sphere,
+           shortcuts, bad);
+    assert_int_equal(bad, 0);
+    assert_true(on_sphere > N / 10);
+    /* must fail: the spheres left out of Embree's tree and not intersected by the host are missing */
+    size_t n = s->nfew_spheres;
+    s->nfew_spheres = 0;
+    murk_ray at_sphere = {murk_v3(0.0f, 0.5f, 2.0f), murk_v3(0.0f, 0.0f, -1.0f), 0.0f, INFINITY};
+    int sc, agrees = eshape_agrees(s, ref, &at_sphere, &sc);
+    s->nfew_spheres = n;
+    printf("must fail: the few spheres without the host's test %s\n", agrees ? "went unnoticed" : "are seen");
+    assert_false(agrees);
+    assert_true(eshape_agrees(s, ref, &at_sphere, &sc));
+    murk_scene_free(ref);
+    murk_scene_free(s);
+    /* more spheres than MURK_FEW_SPHERES: all stay in Embree's tree */
+    char many[1024] = "";
+    for (int i = 0; i < MURK_FEW_SPHERES; i++)
+        snprintf(many + strlen(many), sizeof many - strlen(many),
+                 "  - { type: sphere, center: [%d, 2, 0], radius: 0.1, material: white }\n", i);
+    s = eshape_load(first, many);
+    printf("%d spheres: %zu host-intersected (expected 0)\n", MURK_FEW_SPHERES + 1, s->nfew_spheres);
+    assert_int_equal(s->nfew_spheres, 0);
+    murk_scene_free(s);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shadow),
         cmocka_unit_test(test_shadow_once),
         cmocka_unit_test(test_empty_box),
+        cmocka_unit_test(test_few_spheres),
         cmocka_unit_test(long_nee),
         cmocka_unit_test(long_path),
     };

@@ -25,6 +25,7 @@ MURK_API void murk_scene_free(murk_scene *s)
         return;
     murk_warn_forget(s);
     free(s->empty_shapes);
+    free(s->few_spheres);
     if (s->rtc)
         rtcReleaseScene(s->rtc);
     if (s->device)

@@ -98,6 +98,14 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
     return 1;
 }
 
+static int is_empty_shape(const murk_scene *s, size_t i)
+{
+    for (size_t k = 0; k < s->nempty_shapes; k++)
+        if (s->empty_shapes[k].geom == i)
+            return 1;
+    return 0;
+}
+
 int murk_accel_build(murk_scene *s, char *err, size_t errlen)
 {
     s->device = rtcNewDevice(NULL);
@@ -173,6 +181,20 @@ int murk_accel_build(murk_scene *s, char *err, size_t errlen)
          * that pass it or cross it do not traverse it */
         rtcDisableGeometry(rtcGetGeometry(s->rtc, b.geom));
     }
+    free(s->few_spheres);
+    s->few_spheres = NULL;
+    s->nfew_spheres = 0;
+    size_t nspheres = 0;
+    for (size_t i = 0; i < s->nshapes; i++)
+        nspheres += s->shapes[i].type == MURK_SHAPE_SPHERE && !is_empty_shape(s, i);
+    for (size_t i = 0; nspheres <= MURK_FEW_SPHERES && i < s->nshapes; i++) {
+        if (s->shapes[i].type != MURK_SHAPE_SPHERE || is_empty_shape(s, i))
+            continue;
+        if (!s->few_spheres)
+            s->few_spheres = murk_xmalloc(nspheres * sizeof *s->few_spheres);
+        s->few_spheres[s->nfew_spheres++] = (uint32_t)i;
+        rtcDisableGeometry(rtcGetGeometry(s->rtc, (unsigned)i)); /* host.c intersects it (accel.h) */
+    }
     rtcCommitScene(s->rtc);
     if (rtcGetDeviceError(s->device) != RTC_ERROR_NONE) {
         murk_err_file(err, errlen, s->doc.file, "Embree failed to build the scene");
@@ -190,5 +212,11 @@ void murk_accel_bounds(const murk_scene *s, murk_vec3 *lo, murk_vec3 *hi)
     for (size_t i = 0; i < s->nempty_shapes; i++) {
         *lo = murk_vmin(*lo, s->empty_shapes[i].lo);
         *hi = murk_vmax(*hi, s->empty_shapes[i].hi);
+    }
+    for (size_t i = 0; i < s->nfew_spheres; i++) {
+        murk_vec3 slo, shi;
+        murk_shape_bounds(&s->shapes[s->few_spheres[i]], &slo, &shi);
+        *lo = murk_vmin(*lo, slo);
+        *hi = murk_vmax(*hi, shi);
     }
 }

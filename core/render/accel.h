@@ -66,6 +66,11 @@ typedef struct murk_empty_shape {
     murk_box_tri tri[6][2]; /* a box: the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */
 } murk_empty_shape;
 
+/* Spheres that are not empty medium shapes, when a scene has at most MURK_FEW_SPHERES of them: host.c
+ * intersects them itself and Embree's tree leaves them out. Embree keeps spheres in a tree of their own
+ * beside the triangles' and traverses both for every ray; for a few spheres a test of each costs less. */
+enum { MURK_FEW_SPHERES = 4 };
+
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium shapes. */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
 /* The bounds of every shape's primitives: Embree's tree's and the empty medium shapes' (which it leaves

@@ -285,6 +285,40 @@ static const murk_empty_shape *shape_entry(const murk_scene *s, const murk_ray *
     return first;
 }
 
+/* The first crossing of sphere (center, radius) by r within (tmin, tmax], or +inf: the centre's foot on
+ * the line and the half chord from the perpendicular distance, which does not cancel for a ray far from
+ * a small sphere (Haines, Günther, Akenine-Möller 2019, "Precision Improvements for Ray/Sphere
+ * Intersection", Ray Tracing Gems ch. 7), as Embree's sphere test does; from inside, the far crossing. */
+static float sphere_first(murk_vec3 center, float radius, const murk_ray *r, float tmax)
+{
+    murk_vec3 oc = murk_sub(center, r->o);
+    float inv_a = 1.0f / murk_dot(r->d, r->d), td = murk_dot(oc, r->d) * inv_a;
+    murk_vec3 perp = murk_sub(oc, murk_mul(r->d, td));
+    float h2 = (radius * radius - murk_dot(perp, perp)) * inv_a;
+    if (!(h2 >= 0.0f))
+        return INFINITY;
+    float h = sqrtf(h2), t0 = td - h, t1 = td + h;
+    if (t0 > r->tmin && t0 <= tmax)
+        return t0;
+    return t1 > r->tmin && t1 <= tmax ? t1 : INFINITY;
+}
+
+/* The first of the scene's few spheres (accel.h) that r crosses within (tmin, tmax]: its distance, +inf if
+ * none; *geom its shape. */
+static float few_spheres_first(const murk_scene *s, const murk_ray *r, float tmax, uint32_t *geom)
+{
+    float first = INFINITY;
+    for (size_t i = 0; i < s->nfew_spheres; i++) {
+        const murk_shape *sh = &s->shapes[s->few_spheres[i]];
+        float t = sphere_first(sh->center, sh->radius, r, tmax);
+        if (t < first) {
+            first = tmax = t;
+            *geom = s->few_spheres[i];
+        }
+    }
+    return first;
+}
+
 /* Barycentrics (b1, b2) of p in box triangle bt, clamped into the triangle; returns the smallest of the
  * three before clamping (negative: p lies outside by that much). */
 static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float *b2)
@@ -353,6 +387,12 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     murk_ray asked = *r; /* what Embree is asked (and a recording replays) */
     if (b)
         asked.tmax = te;
+    /* so are a scene's few spheres: the first one crossed before that point is the answer unless Embree
+     * finds a surface before it */
+    uint32_t sg = 0;
+    float ts = s->nfew_spheres ? few_spheres_first(s, r, asked.tmax, &sg) : INFINITY;
+    if (ts < INFINITY)
+        asked.tmax = ts;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -363,6 +403,12 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     murk_tally()->rays++;
     if (ray_record)
         record_ray(&asked, 0);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID && ts < INFINITY) {
+        rh.ray.tfar = ts;
+        rh.hit.geomID = sg;
+        rh.hit.primID = 0;
+        rh.hit.u = rh.hit.v = 0.0f;
+    }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         if (!b)
             return 0;
@@ -382,6 +428,9 @@ static int host_occluded(const murk_scene *s, const murk_ray *r)
     if (s->nempty_shapes && shape_exit(s, r, &te, &face)) /* nothing inside: only its own surface occludes */
         return te <= r->tmax;
     if (s->nempty_shapes && shape_entry(s, r, r->tmax, &te, &face)) /* not in Embree's tree (accel.h) */
+        return 1;
+    uint32_t sg;
+    if (s->nfew_spheres && few_spheres_first(s, r, r->tmax, &sg) < INFINITY) /* nor are these */
         return 1;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

@@ -128,6 +128,8 @@ struct murk_scene {
     size_t nboundaries; /* shapes without a material: index-matched boundaries (set by murk_accel_build) */
     struct murk_empty_shape *empty_shapes; /* medium boxes and spheres with nothing else inside (render/accel.h) */
     size_t nempty_shapes;
+    uint32_t *few_spheres; /* the other spheres' shape indices when there are few (render/accel.h) */
+    size_t nfew_spheres;
     murk_light *lights;
     size_t nlights;
     float *light_cdf; /* nlights + 1 */

@@ -18,8 +18,8 @@
  *   scatters, shadow the core, around every medium's sample() (flights that ended in a real scattering
  *                    event) and transmittance estimate (shadow-ray segments).
  * Rays traced (the intersect and occluded calls that reach Embree; a ray from inside an empty medium box or
- * sphere, and an occlusion query that one blocks, is answered in closed form and not counted) are counted
- * per render, not per medium (murk_render_result.rays). */
+ * sphere, and an occlusion query that one or one of a scene's few spheres blocks, is answered in closed
+ * form and not counted) are counted per render, not per medium (murk_render_result.rays). */
 #ifndef MURK_COUNTERS_H
 #define MURK_COUNTERS_H
 
