@@ -69,7 +69,7 @@ typedef struct murk_empty_shape {
 /* Spheres that are not empty medium shapes, when a scene has at most MURK_FEW_SPHERES of them: host.c
  * intersects them itself and Embree's tree leaves them out. Embree keeps spheres in a tree of their own
  * beside the triangles' and traverses both for every ray; for a few spheres a test of each costs less. */
-enum { MURK_FEW_SPHERES = 4 };
+enum { MURK_FEW_SPHERES = 8 };
 
 /* Returns 0, or -1 with err = "scene.yaml: what went wrong". Also finds the empty medium shapes. */
 int murk_accel_build(murk_scene *s, char *err, size_t errlen);
