@@ -45,7 +45,8 @@ static int boxes_meet(murk_vec3 alo, murk_vec3 ahi, murk_vec3 blo, murk_vec3 bhi
 }
 
 /* Shape i as an empty medium shape (accel.h), or 0: not a box or a sphere, it holds no medium, something
- * else meets it, or (a box) its faces are not two triangles each with axis-aligned normals. "Meets" uses
+ * else meets it, or (a box) its faces are not two triangles each with axis-aligned normals, or it lacks
+ * the loader's uv or has shading normals or an emission texture (never so for a loaded box). "Meets" uses
  * its bounds grown by 1e-4 of their coordinates' magnitude (the integrators' offset off a surface): a
  * shape on or within rounding of its surface could tie with it or beat it in Embree's arithmetic, so such
  * a shape is left to Embree. */
@@ -54,6 +55,8 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
     const murk_shape *sh = &s->shapes[i];
     b->sphere = sh->type == MURK_SHAPE_SPHERE;
     if (!sh->interior || !(b->sphere || (sh->type == MURK_SHAPE_BOX && sh->ntris == 12)))
+        return 0;
+    if (!b->sphere && (!sh->uv || sh->nrm || sh->emission_tex)) /* host.c fills a face's hit from tri alone */
         return 0;
     b->center = sh->center;
     b->radius = sh->radius;
@@ -71,7 +74,6 @@ static int empty_shape(const murk_scene *s, size_t i, murk_empty_shape *b)
     }
     int n[6] = {0};
     b->geom = (uint32_t)i;
-    b->plain = !b->sphere && sh->uv && !sh->nrm && !sh->emission_tex;
     for (uint32_t t = 0; !b->sphere && t < 12; t++) {
         const float *g = &sh->ng[3 * t];
         int a = fabsf(g[0]) > 0.5f ? 0 : (fabsf(g[1]) > 0.5f ? 1 : 2);

@@ -60,7 +60,6 @@ typedef struct murk_empty_shape {
     murk_vec3 lo, hi;       /* its bounds */
     uint32_t geom;          /* the shape's index (its Embree geometry id) */
     int sphere;             /* 1: a sphere (center, radius), else a box (tri) */
-    int plain;              /* a box with uv and without shading normals or an emission texture: hits from tri alone */
     murk_vec3 center;
     float radius;
     murk_box_tri tri[6][2]; /* a box: the two triangles of face 2a (the +a side, a = x, y, z) and 2a + 1 (-a) */

@@ -333,39 +333,36 @@ static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float 
 }
 
 /* The hit where r meets shape b at t (a box: on face f), leaving or entering it, as Embree would report
- * it: a sphere's only primitive; a box face's triangle that holds the point (the first unless the point
- * lies outside it) and its barycentrics. */
+ * it: a sphere's only primitive (fill_hit); a box face's triangle that holds the point (the first unless
+ * the point lies outside it) and its barycentrics, the rest as fill_hit computes it from the face's own
+ * copy of that triangle (accel.h). */
 static void shape_hit(const murk_scene *s, const murk_ray *r, const murk_empty_shape *b, float t, int f, murk_hit *h)
 {
-    float u = 0.0f, v = 0.0f, u1, v1;
-    int k = 0;
-    if (!b->sphere) {
-        murk_vec3 p = murk_madd(r->o, r->d, t);
-        float least = barycentrics(&b->tri[f][0], p, &u, &v);
-        if (least < 0.0f && barycentrics(&b->tri[f][1], p, &u1, &v1) > least) {
-            k = 1;
-            u = u1;
-            v = v1;
-        }
-    }
-    if (b->plain) { /* fill_hit's result from the face's own copy of its triangle */
-        const murk_box_tri *bt = &b->tri[f][k];
-        h->t = t;
-        h->geom = b->geom;
-        h->prim = bt->prim;
-        h->p = tri_point(bt->a, bt->b, bt->c, u, v);
-        h->ng = h->n = bt->ng;
-        tri_uv(&bt->uv[0], &bt->uv[2], &bt->uv[4], u, v, h);
-        hit_shape_fields(&s->shapes[b->geom], h);
+    if (b->sphere) {
+        struct RTCRayHit rh;
+        rh.ray.tfar = t;
+        rh.hit.geomID = b->geom;
+        rh.hit.primID = 0;
+        rh.hit.u = rh.hit.v = 0.0f;
+        fill_hit(s, r, &rh, h);
         return;
     }
-    struct RTCRayHit rh;
-    rh.ray.tfar = t;
-    rh.hit.geomID = b->geom;
-    rh.hit.primID = b->sphere ? 0 : b->tri[f][k].prim;
-    rh.hit.u = u;
-    rh.hit.v = v;
-    fill_hit(s, r, &rh, h);
+    float u, v, u1, v1;
+    murk_vec3 p = murk_madd(r->o, r->d, t);
+    const murk_box_tri *bt = &b->tri[f][0];
+    float least = barycentrics(bt, p, &u, &v);
+    if (least < 0.0f && barycentrics(&b->tri[f][1], p, &u1, &v1) > least) {
+        bt = &b->tri[f][1];
+        u = u1;
+        v = v1;
+    }
+    h->t = t;
+    h->geom = b->geom;
+    h->prim = bt->prim;
+    h->p = tri_point(bt->a, bt->b, bt->c, u, v);
+    h->ng = h->n = bt->ng;
+    tri_uv(&bt->uv[0], &bt->uv[2], &bt->uv[4], u, v, h);
+    hit_shape_fields(&s->shapes[b->geom], h);
 }
 
 static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
