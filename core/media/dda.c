@@ -3,7 +3,6 @@
 #include "media/density.h"
 
 #include <math.h>
-#include <string.h>
 
 /* Parameter at which the ray leaves the current cell along axis a (INFINITY if it never does, or
  * if it cannot step further because this is the last cell: the last cell then absorbs rounding). */
@@ -22,7 +21,7 @@ void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, fl
 {
     if (isinf(g->lo.x) && t0 < t1) { /* infinite (constant) grid: one segment; murk_dda_next reads only
                                       * these fields of it (a homogeneous medium's every flight and shadow
-                                      * ray starts here, so the clearing below is skipped) */
+                                      * ray starts here) */
         it->g = g;
         it->t = it->tin = t0;
         it->t1 = it->tout = t1;
@@ -30,8 +29,7 @@ void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, fl
         it->phase = DDA_INSIDE;
         return;
     }
-    memset(it, 0, sizeof *it);
-    it->g = g;
+    it->g = g; /* every other field murk_dda_next reads is set below or in dda_enter */
     it->t = t0;
     it->t1 = t1;
     it->cell[0] = it->cell[1] = it->cell[2] = -1;
@@ -51,12 +49,13 @@ void murk_dda_init(murk_dda *it, const murk_bound_grid *g, const murk_ray *r, fl
         double o = it->o[a], d = it->d[a], lo = murk_v3_get(g->lo, a), hi = murk_v3_get(g->hi, a);
         if (!isfinite(o) || !isfinite(d))
             return; /* a broken ray sees no density */
+        it->inv_d[a] = d != 0.0 ? 1.0 / d : 0.0; /* one division per axis and walk (dda_enter's too) */
         if (d == 0.0) {
             if (o < lo || o > hi)
                 return;
             continue;
         }
-        double ta = (lo - o) / d, tb = (hi - o) / d;
+        double ta = (lo - o) * it->inv_d[a], tb = (hi - o) * it->inv_d[a];
         if (ta > tb) {
             double t = ta;
             ta = tb;
@@ -81,9 +80,8 @@ static void dda_enter(murk_dda *it)
     for (int a = 0; a < 3; a++) {
         double d = it->d[a];
         it->step[a] = d > 0.0 ? 1 : (d < 0.0 ? -1 : 0);
-        it->h[a] = ((double)murk_v3_get(g->hi, a) - murk_v3_get(g->lo, a)) / g->res[a];
-        it->inv_d[a] = d != 0.0 ? 1.0 / d : 0.0;
-        double u = (it->o[a] + d * it->t - murk_v3_get(g->lo, a)) / it->h[a];
+        it->h[a] = g->h[a];
+        double u = (it->o[a] + d * it->t - murk_v3_get(g->lo, a)) * g->inv_h[a];
         it->idx[a] = u <= 0.0 ? 0 : (u >= g->res[a] - 1 ? g->res[a] - 1 : (int)floor(u));
     }
 }

@@ -110,6 +110,7 @@ void murk_field_free(murk_field *f);
 typedef struct murk_bound_grid {
     int res[3];
     murk_vec3 lo, hi;
+    double h[3], inv_h[3]; /* a cell's size per axis and its reciprocal (the DDA's, set once here) */
     float *maj, *min;
 } murk_bound_grid;
 

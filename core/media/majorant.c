@@ -8,6 +8,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The cell size per axis and its reciprocal, which every DDA walk uses (infinite for an infinite box). */
+static void cell_size(murk_bound_grid *g)
+{
+    for (int a = 0; a < 3; a++) {
+        g->h[a] = ((double)murk_v3_get(g->hi, a) - murk_v3_get(g->lo, a)) / g->res[a];
+        g->inv_h[a] = 1.0 / g->h[a];
+    }
+}
+
 int murk_bound_grid_build(const murk_field *f, int target_res, murk_bound_grid *g)
 {
     memset(g, 0, sizeof *g);
@@ -17,6 +26,7 @@ int murk_bound_grid_build(const murk_field *f, int target_res, murk_bound_grid *
         g->res[0] = g->res[1] = g->res[2] = 1;
         g->lo = f->lo;
         g->hi = f->hi;
+        cell_size(g);
         g->maj = malloc(sizeof *g->maj);
         g->min = malloc(sizeof *g->min);
         if (!g->maj || !g->min) {
@@ -41,6 +51,7 @@ int murk_bound_grid_build(const murk_field *f, int target_res, murk_bound_grid *
     }
     g->lo = f->lo;
     g->hi = f->hi;
+    cell_size(g);
     size_t n = (size_t)g->res[0] * (size_t)g->res[1] * (size_t)g->res[2];
     g->maj = malloc(n * sizeof *g->maj);
     g->min = malloc(n * sizeof *g->min);
