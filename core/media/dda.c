@@ -11,7 +11,7 @@ static double dda_tnext(const murk_dda *it, int a)
     int s = it->step[a], i = it->idx[a];
     if (s == 0 || (s > 0 && i >= it->g->res[a] - 1) || (s < 0 && i <= 0))
         return INFINITY;
-    double b = murk_v3_get(it->g->lo, a) + (s > 0 ? i + 1 : i) * it->h[a];
+    double b = murk_v3_get(it->g->lo, a) + (s > 0 ? i + 1 : i) * it->g->h[a];
     return (b - it->o[a]) * it->inv_d[a];
 }
 
@@ -80,7 +80,6 @@ static void dda_enter(murk_dda *it)
     for (int a = 0; a < 3; a++) {
         double d = it->d[a];
         it->step[a] = d > 0.0 ? 1 : (d < 0.0 ? -1 : 0);
-        it->h[a] = g->h[a];
         double u = (it->o[a] + d * it->t - murk_v3_get(g->lo, a)) * g->inv_h[a];
         it->idx[a] = u <= 0.0 ? 0 : (u >= g->res[a] - 1 ? g->res[a] - 1 : (int)floor(u));
     }

@@ -133,7 +133,7 @@ void murk_bound_grid_free(murk_bound_grid *g);
 typedef struct murk_dda {
     const murk_bound_grid *g;
     double o[3], d[3];    /* ray origin and direction */
-    double inv_d[3], h[3]; /* 1/d (unused where d is 0); the grid's cell size */
+    double inv_d[3];      /* 1/d (0 where d is 0) */
     float t, t1;          /* start of the next segment; end of the range */
     float tin, tout;      /* the ray's parameter range inside the grid box (tin > tout: missed) */
     int phase;            /* before the box, entering, inside, after the box, done */

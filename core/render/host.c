@@ -332,6 +332,17 @@ static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float 
     return least;
 }
 
+/* The hit where r meets sphere shape geom at t: its only primitive, as Embree reports it (fill_hit). */
+static void sphere_hit(const murk_scene *s, const murk_ray *r, uint32_t geom, float t, murk_hit *h)
+{
+    struct RTCRayHit rh;
+    rh.ray.tfar = t;
+    rh.hit.geomID = geom;
+    rh.hit.primID = 0;
+    rh.hit.u = rh.hit.v = 0.0f;
+    fill_hit(s, r, &rh, h);
+}
+
 /* The hit where r meets shape b at t (a box: on face f), leaving or entering it, as Embree would report
  * it: a sphere's only primitive (fill_hit); a box face's triangle that holds the point (the first unless
  * the point lies outside it) and its barycentrics, the rest as fill_hit computes it from the face's own
@@ -339,12 +350,7 @@ static float barycentrics(const murk_box_tri *bt, murk_vec3 p, float *b1, float 
 static void shape_hit(const murk_scene *s, const murk_ray *r, const murk_empty_shape *b, float t, int f, murk_hit *h)
 {
     if (b->sphere) {
-        struct RTCRayHit rh;
-        rh.ray.tfar = t;
-        rh.hit.geomID = b->geom;
-        rh.hit.primID = 0;
-        rh.hit.u = rh.hit.v = 0.0f;
-        fill_hit(s, r, &rh, h);
+        sphere_hit(s, r, b->geom, t, h);
         return;
     }
     float u, v, u1, v1;
@@ -401,10 +407,8 @@ static int host_intersect(const murk_scene *s, const murk_ray *r, murk_hit *h)
     if (ray_record)
         record_ray(&asked, 0);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID && ts < INFINITY) {
-        rh.ray.tfar = ts;
-        rh.hit.geomID = sg;
-        rh.hit.primID = 0;
-        rh.hit.u = rh.hit.v = 0.0f;
+        sphere_hit(s, r, sg, ts, h);
+        return 1;
     }
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         if (!b)
